@@ -1,0 +1,62 @@
+#include "app/bench_command.hpp"
+
+#include <cmath>
+#include <iostream>
+#include <memory>
+
+#include "app/cli_error.hpp"
+#include "app/map_options.hpp"
+#include "bench/replan_bench.hpp"
+#include "maps/synthetic_grid.hpp"
+
+namespace corridor::app {
+namespace {
+
+struct ReplanOptions {
+  MapOptions map;
+  bench::ReplanBenchConfig config;
+  std::uint32_t synthetic_grid_nodes = 0;
+};
+
+void run_replan(const ReplanOptions& o) {
+  if (o.config.trips == 0) throw UsageError("--trips must be at least 1");
+  if (o.config.updates_per_batch == 0) throw UsageError("--updates must be at least 1");
+  if (!(o.config.vmax_kmh > 0 && o.config.vmax_kmh <= 400)) throw UsageError("--vmax-kmh must be in (0, 400]");
+  nlohmann::json out;
+  if (o.synthetic_grid_nodes > 0) {
+    if (!o.map.map_file.empty()) throw UsageError("give either --map or --synthetic-grid, not both");
+    maps::GridSpec spec;
+    spec.rows = spec.cols = static_cast<std::uint32_t>(std::ceil(std::sqrt(o.synthetic_grid_nodes)));
+    spec.seed = o.config.seed;
+    const maps::RoadGraph graph = maps::make_perturbed_grid(spec);
+    out = bench::to_json(bench::run_replan_bench(graph, o.config), o.config);
+    out["map"] = "synthetic perturbed grid " + std::to_string(spec.rows) + "x" + std::to_string(spec.cols);
+  } else {
+    const maps::RoadGraph graph = load_map_from_options(o.map);
+    out = bench::to_json(bench::run_replan_bench(graph, o.config), o.config);
+    out["map"] = o.map.map_file.empty() ? "embedded monaco.osm.gz" : o.map.map_file;
+  }
+  std::cout << out.dump(2) << '\n';
+}
+
+}  // namespace
+
+void register_bench_command(CLI::App& app) {
+  auto* bench_cmd = app.add_subcommand("bench", "Benchmarks that print JSON");
+  bench_cmd->require_subcommand(1);
+  auto o = std::make_shared<ReplanOptions>();
+  auto* replan = bench_cmd->add_subcommand("replan", "D* Lite repair vs A*/Dijkstra from scratch while driving");
+  add_map_options(*replan, o->map);
+  replan->add_option("--synthetic-grid", o->synthetic_grid_nodes,
+                     "instead of --map: a perturbed grid with about this many nodes (e.g. 250000)");
+  replan->add_option("--trips", o->config.trips, "simulated trips")->capture_default_str();
+  replan->add_option("--updates", o->config.updates_per_batch, "congestion updates per batch")->capture_default_str();
+  replan->add_option("--seed", o->config.seed, "random seed")->capture_default_str();
+  replan->add_option("--drive-step-s", o->config.drive_step_s, "driving time between batches")->capture_default_str();
+  replan->add_option("--vmax-kmh", o->config.vmax_kmh, "vehicle maximum speed")->capture_default_str();
+  replan->add_option("--min-trip-m", o->config.min_trip_m, "minimum straight-line trip length (0 = auto)");
+  replan->add_flag("!--no-dijkstra", o->config.run_dijkstra, "skip the Dijkstra baseline (and the mismatch check)");
+  replan->callback([o] { run_replan(*o); });
+}
+
+}  // namespace corridor::app

@@ -1,0 +1,40 @@
+// The `corridor` executable: parses the command line and hands over to the modules.
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <iostream>
+
+#include "app/bench_command.hpp"
+#include "app/cli_error.hpp"
+#include "app/map_command.hpp"
+#include "app/route_command.hpp"
+#include "maps/errors.hpp"
+
+int main(int argc, char** argv) {
+  // Logs go to stderr so that stdout carries only the command's JSON.
+  spdlog::set_default_logger(spdlog::stderr_color_mt("corridor"));
+  spdlog::set_pattern("%Y-%m-%dT%H:%M:%S.%e %^%l%$ %v");
+
+  CLI::App app{"Corridor: green corridors for emergency vehicles"};
+  app.require_subcommand(1);
+  std::string log_level = "warn";
+  app.add_option("--log-level", log_level, "trace, debug, info, warn, error or off")->capture_default_str();
+  app.parse_complete_callback([&] { spdlog::set_level(spdlog::level::from_str(log_level)); });
+  corridor::app::register_route_command(app);
+  corridor::app::register_map_command(app);
+  corridor::app::register_bench_command(app);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const corridor::app::UsageError& e) {
+    std::cerr << "error: " << e.what() << '\n';
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << '\n';
+    return 1;
+  }
+  return 0;
+}

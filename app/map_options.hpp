@@ -1,0 +1,23 @@
+// CLI options shared by every subcommand that loads a map: --map, --cache-dir, --no-cache.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <filesystem>
+#include <string>
+
+#include "maps/map_loader.hpp"
+
+namespace corridor::app {
+
+struct MapOptions {
+  std::string map_file;  // empty = the embedded default map
+  std::string cache_dir;
+  bool no_cache = false;
+};
+
+void add_map_options(CLI::App& cmd, MapOptions& options);
+
+// Resolves defaults ($CORRIDOR_CACHE_DIR, $XDG_CACHE_HOME/corridor, ~/.cache/corridor) and loads.
+maps::RoadGraph load_map_from_options(const MapOptions& options, maps::MapLoadInfo* info = nullptr);
+
+}  // namespace corridor::app

@@ -1,0 +1,251 @@
+#include "bench/replan_bench.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <random>
+#include <stdexcept>
+#include <unordered_set>
+
+#include "maps/progress.hpp"
+#include "planner/cost_overlay.hpp"
+#include "planner/dstar_lite.hpp"
+#include "planner/one_to_one_search.hpp"
+
+namespace corridor::bench {
+namespace {
+
+using planner::EdgePoint;
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+bool costs_differ(double a, double b) {
+  if (a >= planner::kInfCost || b >= planner::kInfCost) return a != b;
+  return std::abs(a - b) > 1e-9 * std::max({1.0, std::abs(a), std::abs(b)});
+}
+
+// Where the vehicle is after driving `seconds` along `route` under the current costs, or nullopt
+// when it reaches the goal first.
+std::optional<EdgePoint> drive(const planner::TravelCost& cost, const planner::Route& route, double seconds) {
+  const auto& g = cost.graph();
+  double left = seconds;
+  for (std::size_t i = 0; i < route.edges.size(); ++i) {
+    const EdgeId e = route.edges[i];
+    const double from = i == 0 ? route.start.offset_m : 0.0;
+    const double to = i + 1 == route.edges.size() ? route.goal.offset_m : g.length_m(e);
+    const double before_edge = i == 0 ? 0.0 : cost.node_delay_s(g.tail(e));
+    if (left <= before_edge) return EdgePoint{e, from};
+    left -= before_edge;
+    const double t = cost.partial_time_s(e, from, to);
+    if (left < t) return EdgePoint{e, from + (left / t) * (to - from)};  // queue delay spread over the edge
+    left -= t;
+  }
+  return std::nullopt;
+}
+
+class UpdateGenerator {
+ public:
+  UpdateGenerator(const maps::RoadGraph& graph, const ReplanBenchConfig& config, std::mt19937_64& rng)
+      : graph_(graph), config_(config), rng_(rng) {}
+
+  // Picks `count` edges: some ahead on the route, some next to it, the rest anywhere.
+  std::vector<EdgeId> pick(const planner::Route& route) {
+    std::vector<EdgeId> out;
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    std::uniform_int_distribution<std::uint32_t> any_edge(0, static_cast<std::uint32_t>(graph_.edge_count() - 1));
+    for (std::uint32_t i = 0; i < config_.updates_per_batch; ++i) {
+      const double r = unit(rng_);
+      EdgeId e{any_edge(rng_)};
+      if (r < config_.on_route_fraction && !route.edges.empty()) {
+        e = route.edges[std::uniform_int_distribution<std::size_t>(0, route.edges.size() - 1)(rng_)];
+      } else if (r < config_.on_route_fraction + config_.near_route_fraction && !route.nodes.empty()) {
+        const NodeId n = route.nodes[std::uniform_int_distribution<std::size_t>(0, route.nodes.size() - 1)(rng_)];
+        const auto outs = graph_.out_edges(n);
+        const auto ins = graph_.in_edges(n);
+        const std::size_t k = std::uniform_int_distribution<std::size_t>(0, outs.size() + ins.size() - 1)(rng_);
+        e = k < outs.size() ? EdgeId{(*outs.begin()).v + static_cast<std::uint32_t>(k)} : ins[k - outs.size()];
+      }
+      out.push_back(e);
+    }
+    return out;
+  }
+
+  // Slower (congestion, queues, rarely a closure) or faster (congestion clearing).
+  planner::EdgeCondition condition() {
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    const double r = unit(rng_);
+    if (r < 0.03) return {planner::kInfCost, 0.0};
+    if (r < 0.6) return {1.0 + 3.0 * unit(rng_), unit(rng_) < 0.5 ? 60.0 * unit(rng_) : 0.0};
+    if (r < 0.8) return {};
+    return {0.6 + 0.4 * unit(rng_), 0.0};
+  }
+
+ private:
+  const maps::RoadGraph& graph_;
+  const ReplanBenchConfig& config_;
+  std::mt19937_64& rng_;
+};
+
+}  // namespace
+
+LatencySummary summarize_ms(std::vector<double> samples) {
+  LatencySummary s;
+  s.count = samples.size();
+  if (samples.empty()) return s;
+  std::sort(samples.begin(), samples.end());
+  auto rank = [&](double q) {
+    const auto i = static_cast<std::size_t>(std::ceil(q * static_cast<double>(samples.size()))) - 1;
+    return samples[std::min(i, samples.size() - 1)];
+  };
+  s.p50_ms = rank(0.50);
+  s.p95_ms = rank(0.95);
+  s.max_ms = samples.back();
+  double sum = 0;
+  for (double x : samples) sum += x;
+  s.mean_ms = sum / static_cast<double>(samples.size());
+  return s;
+}
+
+ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBenchConfig& config) {
+  if (config.trips == 0) throw std::invalid_argument("--trips must be at least 1");
+  if (config.on_route_fraction < 0 || config.near_route_fraction < 0 ||
+      config.on_route_fraction + config.near_route_fraction > 1.0) {
+    throw std::invalid_argument("update fractions must be >= 0 and sum to at most 1");
+  }
+  if (!(config.drive_step_s > 0)) throw std::invalid_argument("drive step must be positive");
+
+  std::mt19937_64 rng(config.seed);
+  UpdateGenerator updates(graph, config, rng);
+  const double diagonal = maps::distance_m(graph.min_corner(), graph.max_corner());
+  const double min_trip = config.min_trip_m > 0 ? config.min_trip_m : std::min(5000.0, diagonal / 3.0);
+  const planner::VehicleProfile vehicle{config.vmax_kmh / 3.6};
+
+  ReplanBenchResult res;
+  res.nodes = graph.node_count();
+  res.edges = graph.edge_count();
+  std::vector<double> t_dstar, t_astar, t_dijkstra, t_dstar0, t_astar0;
+  double expanded = 0, astar_settled = 0, dijkstra_settled = 0;
+  planner::OneToOneSearch astar, dijkstra;
+  std::uniform_int_distribution<std::uint32_t> any_edge(0, static_cast<std::uint32_t>(graph.edge_count() - 1));
+  maps::ProgressBar progress("bench replan", config.trips);
+
+  for (std::uint32_t trip = 0; trip < config.trips; ++trip) {
+    planner::CostOverlay overlay(graph);
+    const planner::TravelCost cost(graph, overlay, vehicle);
+    EdgePoint start, goal;
+    for (int attempt = 0;; ++attempt) {
+      start = {EdgeId{any_edge(rng)}, 0.0};
+      goal = {EdgeId{any_edge(rng)}, 0.0};
+      start.offset_m = graph.length_m(start.edge) * 0.5;
+      goal.offset_m = graph.length_m(goal.edge) * 0.5;
+      if (maps::distance_m(graph.point_along(start.edge, start.offset_m), graph.point_along(goal.edge, goal.offset_m)) >=
+              min_trip ||
+          attempt > 1000) {
+        break;
+      }
+    }
+    auto t0 = Clock::now();
+    planner::DStarLite dstar(cost, {start}, {goal});
+    dstar.replan();
+    planner::Route route = dstar.route();
+    t_dstar0.push_back(ms_since(t0));
+    t0 = Clock::now();
+    (void)astar.run(planner::SearchSpace(cost, {start}, {goal}), true);
+    t_astar0.push_back(ms_since(t0));
+    ++res.trips;
+
+    std::unordered_set<std::uint32_t> changed_set;
+    for (std::uint32_t step = 0; step < config.max_replans_per_trip && route.found; ++step) {
+      const auto position = drive(cost, route, config.drive_step_s);
+      if (!position) break;
+
+      changed_set.clear();
+      std::vector<EdgeId> changed;
+      for (EdgeId e : updates.pick(route)) {
+        overlay.set_edge(e, updates.condition());
+        if (changed_set.insert(e.v).second) changed.push_back(e);
+      }
+
+      t0 = Clock::now();
+      dstar.move_start({*position});
+      dstar.edges_changed(changed);
+      const auto stats = dstar.replan();
+      planner::Route next = dstar.route();
+      t_dstar.push_back(ms_since(t0));
+      expanded += static_cast<double>(stats.expanded);
+
+      const planner::SearchSpace space(cost, {*position}, {goal});
+      planner::SearchStats s_astar, s_dijkstra;
+      t0 = Clock::now();
+      const planner::Route a = astar.run(space, true, &s_astar);
+      t_astar.push_back(ms_since(t0));
+      astar_settled += static_cast<double>(s_astar.settled);
+
+      if (config.run_dijkstra) {
+        t0 = Clock::now();
+        const planner::Route d = dijkstra.run(space, false, &s_dijkstra);
+        t_dijkstra.push_back(ms_since(t0));
+        dijkstra_settled += static_cast<double>(s_dijkstra.settled);
+        if (costs_differ(dstar.cost_to_goal_s(), d.travel_time_s) || costs_differ(next.travel_time_s, d.travel_time_s)) {
+          ++res.mismatches;
+          spdlog::warn("event=mismatch trip={} step={} dstar_s={:.9f} dijkstra_s={:.9f}", trip, step,
+                       dstar.cost_to_goal_s(), d.travel_time_s);
+        }
+        if (costs_differ(a.travel_time_s, d.travel_time_s)) ++res.astar_mismatches;
+      }
+      ++res.replans;
+      // Unchanged means: the new route is the rest of the old one from the vehicle's edge on.
+      const auto from = std::find(route.edges.begin(), route.edges.end(), next.edges.empty() ? kInvalidEdge : next.edges.front());
+      if (!std::equal(from, route.edges.end(), next.edges.begin(), next.edges.end())) ++res.route_changes;
+      route = std::move(next);
+    }
+    progress.update(trip + 1);
+  }
+  progress.finish();
+
+  res.dstar = summarize_ms(t_dstar);
+  res.astar = summarize_ms(t_astar);
+  res.dijkstra = summarize_ms(t_dijkstra);
+  res.dstar_initial = summarize_ms(t_dstar0);
+  res.astar_initial = summarize_ms(t_astar0);
+  const double n = res.replans > 0 ? static_cast<double>(res.replans) : 1.0;
+  res.dstar_mean_expanded = expanded / n;
+  res.astar_mean_settled = astar_settled / n;
+  res.dijkstra_mean_settled = dijkstra_settled / n;
+  return res;
+}
+
+nlohmann::json to_json(const ReplanBenchResult& r, const ReplanBenchConfig& c) {
+  auto lat = [](const LatencySummary& s) {
+    return nlohmann::json{{"count", s.count}, {"p50_ms", s.p50_ms}, {"p95_ms", s.p95_ms}, {"max_ms", s.max_ms},
+                          {"mean_ms", s.mean_ms}};
+  };
+  auto ratio = [](double a, double b) { return b > 0 ? a / b : 0.0; };
+  nlohmann::json j;
+  j["graph"] = {{"nodes", r.nodes}, {"edges", r.edges}};
+  j["trips"] = r.trips;
+  j["updates_per_batch"] = c.updates_per_batch;
+  j["seed"] = c.seed;
+  j["drive_step_s"] = c.drive_step_s;
+  j["replans"] = r.replans;
+  j["route_changes"] = r.route_changes;
+  j["dstar"] = lat(r.dstar);
+  j["dstar"]["mean_expanded"] = r.dstar_mean_expanded;
+  j["astar"] = lat(r.astar);
+  j["astar"]["mean_settled"] = r.astar_mean_settled;
+  if (c.run_dijkstra) {
+    j["dijkstra"] = lat(r.dijkstra);
+    j["dijkstra"]["mean_settled"] = r.dijkstra_mean_settled;
+  }
+  j["initial_plan"] = {{"dstar", lat(r.dstar_initial)}, {"astar", lat(r.astar_initial)}};
+  j["speedup_p50_vs_astar"] = ratio(r.astar.p50_ms, r.dstar.p50_ms);
+  j["speedup_p50_vs_dijkstra"] = c.run_dijkstra ? ratio(r.dijkstra.p50_ms, r.dstar.p50_ms) : 0.0;
+  j["mismatches"] = r.mismatches;
+  j["astar_mismatches"] = r.astar_mismatches;
+  return j;
+}
+
+}  // namespace corridor::bench

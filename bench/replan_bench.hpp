@@ -1,0 +1,56 @@
+// `corridor bench replan`: vehicles drive their routes while congestion updates arrive; after each
+// batch D* Lite repairs its plan and A* and Dijkstra replan from scratch. Reports per-replan
+// latencies, speedups measured in the same run, and D* Lite's mismatches against Dijkstra.
+#pragma once
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+
+#include "maps/road_graph.hpp"
+
+namespace corridor::bench {
+
+struct ReplanBenchConfig {
+  std::uint32_t trips = 50;
+  std::uint32_t updates_per_batch = 20;
+  std::uint64_t seed = 1;
+  double drive_step_s = 10.0;      // driving time between two update batches
+  double vmax_kmh = 120.0;
+  double on_route_fraction = 0.25;  // of each batch: edges ahead on the current route
+  double near_route_fraction = 0.25;  // edges touching the route's intersections
+  double min_trip_m = 0.0;         // straight-line; 0 = a third of the map's diagonal, at most 5 km
+  bool run_dijkstra = true;
+  std::uint32_t max_replans_per_trip = 1000;
+};
+
+struct LatencySummary {
+  std::size_t count = 0;
+  double p50_ms = 0;
+  double p95_ms = 0;
+  double max_ms = 0;
+  double mean_ms = 0;
+};
+
+LatencySummary summarize_ms(std::vector<double> samples_ms);
+
+struct ReplanBenchResult {
+  std::size_t nodes = 0;
+  std::size_t edges = 0;
+  std::size_t trips = 0;
+  std::size_t replans = 0;
+  std::size_t mismatches = 0;  // |D* Lite − Dijkstra| > 1e-9 relative
+  std::size_t astar_mismatches = 0;
+  std::size_t route_changes = 0;  // replans after which D* Lite's route differs from before
+  LatencySummary dstar, astar, dijkstra;
+  LatencySummary dstar_initial, astar_initial;
+  double dstar_mean_expanded = 0;
+  double astar_mean_settled = 0;
+  double dijkstra_mean_settled = 0;
+};
+
+// Throws std::invalid_argument for a config that cannot run (no trips, negative fractions, ...).
+ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBenchConfig& config);
+
+nlohmann::json to_json(const ReplanBenchResult& result, const ReplanBenchConfig& config);
+
+}  // namespace corridor::bench

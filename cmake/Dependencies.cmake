@@ -1,0 +1,29 @@
+# Every third-party dependency comes from Debian 12 packages; scripts/setup.sh installs them.
+find_package(Threads REQUIRED)
+find_package(ZLIB REQUIRED)
+find_package(BZip2 REQUIRED)
+find_package(EXPAT REQUIRED)
+find_package(Boost 1.74 REQUIRED)
+find_package(CLI11 REQUIRED)
+find_package(nlohmann_json 3.10 REQUIRED)
+find_package(spdlog REQUIRED)
+find_package(fmt REQUIRED)
+
+# Debian ships GeographicLib without a CMake config; find the library and header directly.
+find_library(GEOGRAPHICLIB_LIBRARY NAMES GeographicLib REQUIRED)
+find_path(GEOGRAPHICLIB_INCLUDE_DIR GeographicLib/LocalCartesian.hpp REQUIRED)
+add_library(corridor_geographiclib INTERFACE)
+target_link_libraries(corridor_geographiclib INTERFACE ${GEOGRAPHICLIB_LIBRARY})
+target_include_directories(corridor_geographiclib SYSTEM INTERFACE ${GEOGRAPHICLIB_INCLUDE_DIR})
+
+# libosmium is header-only; it needs protozero (PBF) and the compression/XML libraries.
+find_path(OSMIUM_INCLUDE_DIR osmium/osm.hpp REQUIRED)
+find_path(PROTOZERO_INCLUDE_DIR protozero/pbf_reader.hpp REQUIRED)
+add_library(corridor_osmium INTERFACE)
+target_include_directories(corridor_osmium SYSTEM INTERFACE ${OSMIUM_INCLUDE_DIR} ${PROTOZERO_INCLUDE_DIR})
+target_link_libraries(corridor_osmium INTERFACE ZLIB::ZLIB BZip2::BZip2 EXPAT::EXPAT Threads::Threads)
+
+if(CORRIDOR_BUILD_TESTS)
+  find_package(GTest REQUIRED)
+endif()
+find_package(benchmark REQUIRED)

@@ -1,0 +1,40 @@
+// Snaps a lat/lon to the nearest point on a drivable edge, through an R-tree over edge segments.
+#pragma once
+
+#include <memory>
+
+#include "maps/road_graph.hpp"
+
+namespace corridor::maps {
+
+struct SnapOptions {
+  double max_distance_m = 200.0;  // farther than this from every road is an error
+};
+
+struct SnapResult {
+  EdgeId edge;          // the edge whose geometry is nearest
+  double offset_m = 0;  // along `edge`, from its tail, in the edge's length units
+  double distance_m = 0;  // from the query to the road
+  Point2 point;           // the snapped point in the local frame
+  EdgeId twin;            // the same road in the other direction, or invalid
+  double twin_offset_m = 0;
+};
+
+class EdgeSnapper {
+ public:
+  explicit EdgeSnapper(const RoadGraph& graph);
+  ~EdgeSnapper();
+  EdgeSnapper(const EdgeSnapper&) = delete;
+  EdgeSnapper& operator=(const EdgeSnapper&) = delete;
+
+  // Throws SnapError for an invalid coordinate, one outside the map, or one too far from any road.
+  [[nodiscard]] SnapResult snap(LatLon p, const SnapOptions& options = {}) const;
+  [[nodiscard]] SnapResult snap_local(Point2 p, const SnapOptions& options = {}) const;
+
+ private:
+  struct Index;
+  const RoadGraph& graph_;
+  std::unique_ptr<Index> index_;
+};
+
+}  // namespace corridor::maps

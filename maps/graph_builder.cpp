@@ -1,0 +1,124 @@
+#include "maps/graph_builder.hpp"
+
+#include <algorithm>
+#include <numeric>
+
+#include "maps/errors.hpp"
+#include "maps/strongly_connected.hpp"
+
+namespace corridor::maps {
+namespace {
+
+// Edges shorter than this are stretched to it, so that every travel time is positive and path
+// extraction can never cycle through zero-cost edges.
+constexpr double kMinEdgeLengthM = 0.1;
+
+struct DirectedEdge {
+  std::uint32_t tail;
+  std::uint32_t head;
+  std::uint32_t segment;
+  bool reversed;
+  std::uint32_t twin;  // index in the directed-edge list, or max
+};
+
+double polyline_length(const std::vector<Point2>& pts, std::uint32_t first, std::uint32_t last) {
+  double len = 0.0;
+  for (std::uint32_t i = first + 1; i <= last; ++i) len += distance_m(pts[i - 1], pts[i]);
+  return len;
+}
+
+}  // namespace
+
+RoadGraph build_road_graph(const GraphBuildInput& in, GraphBuildReport* report) {
+  constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+  const auto n_in = static_cast<std::uint32_t>(in.node_pos.size());
+
+  std::vector<DirectedEdge> edges;
+  edges.reserve(in.segments.size() * 2);
+  for (std::uint32_t s = 0; s < in.segments.size(); ++s) {
+    const RoadSegment& seg = in.segments[s];
+    if (seg.from == seg.to) continue;  // a loop back to the same intersection never shortens a route
+    std::uint32_t fwd = kNone;
+    if (seg.forward) {
+      fwd = static_cast<std::uint32_t>(edges.size());
+      edges.push_back({seg.from, seg.to, s, false, kNone});
+    }
+    if (seg.backward) {
+      const auto bwd = static_cast<std::uint32_t>(edges.size());
+      edges.push_back({seg.to, seg.from, s, true, fwd});
+      if (fwd != kNone) edges[fwd].twin = bwd;
+    }
+  }
+
+  // Largest strongly connected component, on a temporary CSR.
+  std::vector<std::uint32_t> first_out(n_in + 1, 0), heads(edges.size());
+  for (const auto& e : edges) ++first_out[e.tail + 1];
+  std::partial_sum(first_out.begin(), first_out.end(), first_out.begin());
+  {
+    std::vector<std::uint32_t> fill(first_out.begin(), first_out.end() - 1);
+    for (const auto& e : edges) heads[fill[e.tail]++] = e.head;
+  }
+  const Components comps = strongly_connected_components(first_out, heads);
+
+  // Isolated nodes (no edges at all) are their own component; they count as dropped.
+  std::vector<std::uint32_t> new_id(n_in, kNone);
+  RoadGraphData d;
+  d.origin = in.origin;
+  std::uint32_t kept = 0;
+  for (std::uint32_t u = 0; u < n_in; ++u) {
+    if (comps.component_of[u] != comps.largest) continue;
+    new_id[u] = kept++;
+    d.node_x_m.push_back(in.node_pos[u].x_m);
+    d.node_y_m.push_back(in.node_pos[u].y_m);
+    d.node_osm_id.push_back(in.node_osm[u]);
+    d.node_signalized.push_back(in.node_signalized[u]);
+  }
+
+  // Keep edges inside the component, ordered by new tail (stable, so twins stay deterministic).
+  std::vector<std::uint32_t> order;
+  for (std::uint32_t i = 0; i < edges.size(); ++i) {
+    if (new_id[edges[i].tail] != kNone && new_id[edges[i].head] != kNone) order.push_back(i);
+  }
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::uint32_t a, std::uint32_t b) { return new_id[edges[a].tail] < new_id[edges[b].tail]; });
+  std::vector<std::uint32_t> new_edge(edges.size(), kNone);
+  for (std::uint32_t i = 0; i < order.size(); ++i) new_edge[order[i]] = i;
+
+  if (order.empty()) throw MapLoadError("the map contains no connected drivable road network");
+
+  d.first_out.assign(kept + 1, 0);
+  d.geometry_first.push_back(0);
+  for (std::uint32_t old : order) {
+    const DirectedEdge& e = edges[old];
+    const RoadSegment& seg = in.segments[e.segment];
+    ++d.first_out[new_id[e.tail] + 1];
+    d.edge_tail.push_back(NodeId{new_id[e.tail]});
+    d.edge_head.push_back(NodeId{new_id[e.head]});
+    d.edge_length_m.push_back(std::max(kMinEdgeLengthM, polyline_length(in.points, seg.first_point, seg.last_point)));
+    d.edge_speed_mps.push_back(e.reversed ? seg.backward_speed_mps : seg.forward_speed_mps);
+    d.edge_osm_way.push_back(seg.way);
+    d.edge_class.push_back(seg.road_class);
+    d.edge_twin.push_back(e.twin != kNone && new_edge[e.twin] != kNone ? EdgeId{new_edge[e.twin]} : kInvalidEdge);
+    if (e.reversed) {
+      for (std::uint32_t p = seg.last_point + 1; p-- > seg.first_point;) d.geometry.push_back(in.points[p]);
+    } else {
+      for (std::uint32_t p = seg.first_point; p <= seg.last_point; ++p) d.geometry.push_back(in.points[p]);
+    }
+    d.geometry_first.push_back(static_cast<std::uint32_t>(d.geometry.size()));
+  }
+  std::partial_sum(d.first_out.begin(), d.first_out.end(), d.first_out.begin());
+  build_reverse_adjacency(d);
+
+  if (report != nullptr) {
+    report->input_nodes = n_in;
+    report->kept_nodes = kept;
+    report->dropped_nodes = n_in - kept;
+    report->kept_edges = order.size();
+    report->components = comps.count;
+    report->signalized_nodes =
+        static_cast<std::size_t>(std::count(d.node_signalized.begin(), d.node_signalized.end(), std::uint8_t{1}));
+  }
+  return RoadGraph(std::move(d));
+}
+
+}  // namespace corridor::maps

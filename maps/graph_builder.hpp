@@ -1,0 +1,47 @@
+// Turns road segments between intersections into the CSR RoadGraph: directed edges, twins,
+// geometry, and only the largest strongly connected component.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "maps/road_graph.hpp"
+
+namespace corridor::maps {
+
+// One stretch of road between two graph nodes, in the local metric frame.
+struct RoadSegment {
+  std::uint32_t from = 0;  // index into GraphBuildInput nodes
+  std::uint32_t to = 0;
+  std::uint32_t first_point = 0;  // polyline = points[first_point .. last_point], from -> to
+  std::uint32_t last_point = 0;
+  bool forward = true;
+  bool backward = true;
+  float forward_speed_mps = 0.0f;
+  float backward_speed_mps = 0.0f;
+  OsmWayId way;
+  RoadClass road_class = RoadClass::residential;
+};
+
+struct GraphBuildInput {
+  LatLon origin;
+  std::vector<Point2> node_pos;
+  std::vector<OsmNodeId> node_osm;
+  std::vector<std::uint8_t> node_signalized;
+  std::vector<RoadSegment> segments;
+  std::vector<Point2> points;
+};
+
+struct GraphBuildReport {
+  std::size_t input_nodes = 0;
+  std::size_t kept_nodes = 0;
+  std::size_t dropped_nodes = 0;  // outside the largest strongly connected component
+  std::size_t kept_edges = 0;
+  std::size_t components = 0;
+  std::size_t signalized_nodes = 0;
+};
+
+// Throws MapLoadError when no drivable road remains.
+RoadGraph build_road_graph(const GraphBuildInput& input, GraphBuildReport* report = nullptr);
+
+}  // namespace corridor::maps

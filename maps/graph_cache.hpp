@@ -1,0 +1,33 @@
+// A versioned binary file holding a RoadGraph, so that a map is imported once and loaded in
+// milliseconds afterwards. The header records the source file's size and mtime to detect staleness.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+
+#include "maps/road_graph.hpp"
+
+namespace corridor::maps {
+
+inline constexpr std::uint32_t kGraphCacheVersion = 1;
+
+struct CacheSource {
+  std::uint64_t size_bytes = 0;
+  std::int64_t mtime_ns = 0;
+  friend bool operator==(const CacheSource&, const CacheSource&) = default;
+};
+
+// The size and modification time of a source file.
+CacheSource describe_source(const std::filesystem::path& source);
+
+// Writes atomically (temporary file, then rename). Throws GraphCacheError on I/O failure.
+void write_graph_cache(const std::filesystem::path& file, const RoadGraph& graph, const CacheSource& source);
+
+// Throws GraphCacheError for a missing, truncated, corrupt or other-version file.
+RoadGraph read_graph_cache(const std::filesystem::path& file, CacheSource* source = nullptr);
+
+// True when `file` starts with the cache magic, whatever its name.
+bool looks_like_graph_cache(const std::filesystem::path& file);
+
+}  // namespace corridor::maps

@@ -1,0 +1,79 @@
+#include "maps/map_loader.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cstdio>
+
+#include "maps/errors.hpp"
+#include "maps/graph_cache.hpp"
+
+namespace corridor::maps {
+
+std::filesystem::path cache_file_for(const std::filesystem::path& source, const std::filesystem::path& cache_dir) {
+  std::error_code ec;
+  const auto absolute = std::filesystem::weakly_canonical(source, ec);
+  const std::string key = (ec ? source : absolute).string();
+  std::uint64_t h = 14695981039346656037ULL;
+  for (unsigned char ch : key) {
+    h ^= ch;
+    h *= 1099511628211ULL;
+  }
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+  std::string stem = source.filename().string();
+  return cache_dir / (stem + "-" + hex + ".cgr");
+}
+
+RoadGraph load_map(const std::filesystem::path& file, const MapLoadOptions& options, MapLoadInfo* info) {
+  const auto start = std::chrono::steady_clock::now();
+  MapLoadInfo local;
+  auto finish = [&](RoadGraph graph) {
+    local.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (info != nullptr) *info = local;
+    return graph;
+  };
+
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) throw MapLoadError("map file not found: '" + file.string() + "'");
+  if (looks_like_graph_cache(file)) {
+    local.origin = MapLoadInfo::Origin::cache;
+    local.cache_file = file;
+    return finish(read_graph_cache(file));
+  }
+
+  const CacheSource source = describe_source(file);
+  std::filesystem::path cache;
+  if (!options.cache_dir.empty()) {
+    cache = cache_file_for(file, options.cache_dir);
+    if (std::filesystem::is_regular_file(cache, ec)) {
+      try {
+        CacheSource cached_source;
+        RoadGraph graph = read_graph_cache(cache, &cached_source);
+        if (cached_source == source) {
+          local.origin = MapLoadInfo::Origin::cache;
+          local.cache_file = cache;
+          return finish(std::move(graph));
+        }
+        spdlog::info("event=cache_stale cache={} reason=source_changed", cache.string());
+      } catch (const GraphCacheError& e) {
+        spdlog::warn("event=cache_rejected cache={} reason=\"{}\"", cache.string(), e.what());
+      }
+    }
+  }
+
+  RoadGraph graph = import_osm(file, options.import, &local.import);
+  if (!cache.empty()) {
+    // A cache that cannot be written only costs time on the next start; the import itself succeeded.
+    try {
+      std::filesystem::create_directories(options.cache_dir, ec);
+      write_graph_cache(cache, graph, source);
+      local.cache_file = cache;
+    } catch (const GraphCacheError& e) {
+      spdlog::warn("event=cache_not_written reason=\"{}\"", e.what());
+    }
+  }
+  return finish(std::move(graph));
+}
+
+}  // namespace corridor::maps

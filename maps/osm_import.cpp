@@ -1,0 +1,218 @@
+#include "maps/osm_import.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <osmium/handler.hpp>
+#include <osmium/handler/node_locations_for_ways.hpp>
+#include <osmium/index/map/flex_mem.hpp>
+#include <osmium/io/any_input.hpp>
+#include <osmium/visitor.hpp>
+#include <unordered_map>
+
+#include "maps/errors.hpp"
+#include "maps/osm_tags.hpp"
+#include "maps/progress.hpp"
+
+namespace corridor::maps {
+namespace {
+
+constexpr double kKmhToMps = 1.0 / 3.6;
+
+struct KeptWay {
+  OsmWayId id;
+  WayRules rules;
+  std::uint32_t first_ref;  // refs/locations[first_ref .. first_ref + ref_count)
+  std::uint32_t ref_count;
+};
+
+std::string_view tag(const osmium::TagList& tags, const char* key) {
+  const char* v = tags.get_value_by_key(key);
+  return v == nullptr ? std::string_view{} : std::string_view{v};
+}
+
+// Streams ways (with node locations filled in by NodeLocationsForWays) and signal nodes.
+class RoadCollector : public osmium::handler::Handler {
+ public:
+  void node(const osmium::Node& node) {
+    if (tag(node.tags(), "highway") == "traffic_signals") signals.push_back(node.id());
+  }
+
+  void way(const osmium::Way& way) {
+    ++ways_read;
+    const auto& t = way.tags();
+    WayTags wt;
+    wt.highway = tag(t, "highway");
+    if (wt.highway.empty()) return;
+    wt.junction = tag(t, "junction");
+    wt.oneway = tag(t, "oneway");
+    wt.oneway_emergency = tag(t, "oneway:emergency");
+    wt.maxspeed = tag(t, "maxspeed");
+    wt.maxspeed_forward = tag(t, "maxspeed:forward");
+    wt.maxspeed_backward = tag(t, "maxspeed:backward");
+    wt.access = tag(t, "access");
+    wt.vehicle = tag(t, "vehicle");
+    wt.motor_vehicle = tag(t, "motor_vehicle");
+    wt.motorcar = tag(t, "motorcar");
+    wt.emergency = tag(t, "emergency");
+    wt.area = tag(t, "area");
+    const auto rules = interpret_way(wt);
+    if (!rules || way.nodes().size() < 2) return;
+    ways.push_back({OsmWayId{way.id()}, *rules, static_cast<std::uint32_t>(refs.size()),
+                    static_cast<std::uint32_t>(way.nodes().size())});
+    for (const auto& nr : way.nodes()) {
+      refs.push_back(nr.ref());
+      locations.push_back(nr.location());  // invalid when the extract cut the node off
+    }
+  }
+
+  std::size_t ways_read = 0;
+  std::vector<KeptWay> ways;
+  std::vector<osmium::object_id_type> refs;
+  std::vector<osmium::Location> locations;
+  std::vector<osmium::object_id_type> signals;
+};
+
+using LocationIndex = osmium::index::map::FlexMem<osmium::unsigned_object_id_type, osmium::Location>;
+
+RoadCollector read_file(const std::filesystem::path& path, const OsmImportOptions& options) {
+  RoadCollector collector;
+  try {
+    osmium::io::File file(path.string());
+    osmium::io::Reader reader(file, osmium::osm_entity_bits::node | osmium::osm_entity_bits::way);
+    LocationIndex index;
+    osmium::handler::NodeLocationsForWays<LocationIndex> locations(index);
+    locations.ignore_errors();  // ways crossing the extract's border reference absent nodes
+    ProgressBar progress("importing " + path.filename().string(), reader.file_size());
+    while (osmium::memory::Buffer buffer = reader.read()) {
+      osmium::apply(buffer, locations, collector);
+      if (options.show_progress) progress.update(reader.offset());
+    }
+    reader.close();
+    progress.finish();
+  } catch (const std::exception& e) {
+    throw MapLoadError("cannot read OSM file '" + path.string() + "': " + e.what());
+  }
+  return collector;
+}
+
+}  // namespace
+
+RoadGraph import_osm(const std::filesystem::path& path, const OsmImportOptions& options, OsmImportReport* report) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    throw MapLoadError("map file not found: '" + path.string() + "'");
+  }
+  RoadCollector c = read_file(path, options);
+  std::sort(c.signals.begin(), c.signals.end());
+
+  // Junctions: nodes used more than once (by several ways or twice by one) and way ends. Every
+  // other node is inside a chain and only contributes geometry.
+  std::vector<osmium::object_id_type> sorted_refs;
+  sorted_refs.reserve(c.refs.size());
+  for (std::size_t i = 0; i < c.refs.size(); ++i) {
+    if (c.locations[i].valid()) sorted_refs.push_back(c.refs[i]);
+  }
+  std::sort(sorted_refs.begin(), sorted_refs.end());
+  auto use_count = [&](osmium::object_id_type id) {
+    auto [lo, hi] = std::equal_range(sorted_refs.begin(), sorted_refs.end(), id);
+    return static_cast<std::size_t>(hi - lo);
+  };
+  auto is_signal = [&](osmium::object_id_type id) { return std::binary_search(c.signals.begin(), c.signals.end(), id); };
+
+  if (sorted_refs.empty()) throw MapLoadError("no drivable road in '" + path.string() + "'");
+
+  // Projection centred on the bounding box of the road nodes.
+  osmium::Box box;
+  for (const auto& loc : c.locations) {
+    if (loc.valid()) box.extend(loc);
+  }
+  GraphBuildInput in;
+  in.origin = {(box.bottom_left().lat() + box.top_right().lat()) / 2.0,
+               (box.bottom_left().lon() + box.top_right().lon()) / 2.0};
+  const LocalProjection projection(in.origin);
+
+  std::unordered_map<osmium::object_id_type, std::uint32_t> junction_index;
+  junction_index.reserve(sorted_refs.size() / 4);
+  auto junction = [&](std::size_t ref_i) {
+    const auto id = c.refs[ref_i];
+    auto [it, inserted] = junction_index.try_emplace(id, static_cast<std::uint32_t>(in.node_pos.size()));
+    if (inserted) {
+      in.node_pos.push_back(projection.to_local({c.locations[ref_i].lat(), c.locations[ref_i].lon()}));
+      in.node_osm.push_back(OsmNodeId{id});
+      in.node_signalized.push_back(is_signal(id) ? 1 : 0);
+    }
+    return it->second;
+  };
+
+  struct PendingSignal {
+    std::uint32_t junction;
+    double distance_m;
+  };
+  std::vector<PendingSignal> signal_marks;
+
+  for (const KeptWay& way : c.ways) {
+    const std::uint32_t end = way.first_ref + way.ref_count;
+    std::uint32_t i = way.first_ref;
+    while (i < end) {
+      // A run of consecutive nodes with known locations; missing nodes split the way.
+      while (i < end && !c.locations[i].valid()) ++i;
+      std::uint32_t run_end = i;
+      while (run_end < end && c.locations[run_end].valid()) ++run_end;
+      if (run_end - i >= 2) {
+        std::uint32_t from = junction(i);
+        auto first_point = static_cast<std::uint32_t>(in.points.size());
+        in.points.push_back(in.node_pos[from]);
+        double along = 0.0;
+        std::vector<std::pair<std::uint32_t, double>> interior_signals;  // ref index, distance from start
+        for (std::uint32_t k = i + 1; k < run_end; ++k) {
+          const Point2 p = projection.to_local({c.locations[k].lat(), c.locations[k].lon()});
+          along += distance_m(in.points.back(), p);
+          const bool is_junction = k + 1 == run_end || use_count(c.refs[k]) >= 2;
+          if (!is_junction) {
+            in.points.push_back(p);
+            if (is_signal(c.refs[k])) interior_signals.emplace_back(k, along);
+            continue;
+          }
+          const std::uint32_t to = junction(k);
+          in.points.push_back(in.node_pos[to]);
+          RoadSegment seg;
+          seg.from = from;
+          seg.to = to;
+          seg.first_point = first_point;
+          seg.last_point = static_cast<std::uint32_t>(in.points.size() - 1);
+          seg.forward = way.rules.forward;
+          seg.backward = way.rules.backward;
+          seg.forward_speed_mps = static_cast<float>(way.rules.forward_speed_kmh * kKmhToMps);
+          seg.backward_speed_mps = static_cast<float>(way.rules.backward_speed_kmh * kKmhToMps);
+          seg.way = way.id;
+          seg.road_class = way.rules.road_class;
+          in.segments.push_back(seg);
+          for (const auto& [ref_i, d] : interior_signals) {
+            const double to_end = along - d;
+            signal_marks.push_back(d <= to_end ? PendingSignal{from, d} : PendingSignal{to, to_end});
+          }
+          interior_signals.clear();
+          from = to;
+          along = 0.0;
+          first_point = static_cast<std::uint32_t>(in.points.size());
+          in.points.push_back(in.node_pos[to]);
+        }
+        in.points.pop_back();  // the run's last junction opened a segment that never came
+      }
+      i = run_end;
+    }
+  }
+  for (const auto& mark : signal_marks) {
+    if (mark.distance_m <= options.signal_to_junction_max_m) in.node_signalized[mark.junction] = 1;
+  }
+
+  OsmImportReport local;
+  RoadGraph graph = build_road_graph(in, &local.graph);
+  local.osm_ways_read = c.ways_read;
+  local.osm_ways_kept = c.ways.size();
+  local.osm_signal_nodes = c.signals.size();
+  if (report != nullptr) *report = local;
+  return graph;
+}
+
+}  // namespace corridor::maps

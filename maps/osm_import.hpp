@@ -1,0 +1,30 @@
+// Reads .osm, .osm.gz, .osm.bz2 and .osm.pbf files with libosmium into a RoadGraph for emergency
+// vehicles: drivable ways, degree-2 chains compressed into edges, signalized intersections marked.
+#pragma once
+
+#include <filesystem>
+
+#include "maps/graph_builder.hpp"
+#include "maps/road_graph.hpp"
+
+namespace corridor::maps {
+
+struct OsmImportOptions {
+  // A highway=traffic_signals node on a way (not at its junction) marks the nearest junction along
+  // that way as signalized, if it lies within this distance.
+  double signal_to_junction_max_m = 40.0;
+  bool show_progress = true;
+};
+
+struct OsmImportReport {
+  std::size_t osm_ways_read = 0;
+  std::size_t osm_ways_kept = 0;
+  std::size_t osm_signal_nodes = 0;
+  GraphBuildReport graph;
+};
+
+// Throws MapLoadError with the file name and the cause for a missing, unreadable or corrupt file.
+RoadGraph import_osm(const std::filesystem::path& file, const OsmImportOptions& options = {},
+                     OsmImportReport* report = nullptr);
+
+}  // namespace corridor::maps

@@ -1,0 +1,194 @@
+#include "maps/osm_tags.hpp"
+
+#include <array>
+#include <cctype>
+#include <charconv>
+#include <string>
+#include <utility>
+
+namespace corridor::maps {
+namespace {
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.front()))) s.remove_prefix(1);
+  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.remove_suffix(1);
+  return s;
+}
+
+std::string lower(std::string_view s) {
+  std::string out(s);
+  for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return out;
+}
+
+bool is_one_of(std::string_view v, std::initializer_list<std::string_view> options) {
+  for (auto o : options) {
+    if (v == o) return true;
+  }
+  return false;
+}
+
+constexpr double kMphToKmh = 1.609344;
+constexpr double kKnotToKmh = 1.852;
+constexpr double kNoLimitKmh = 140.0;  // "none": cap used where the law sets no limit
+constexpr double kWalkKmh = 6.0;
+
+// Implicit limits by country and zone. Generic values cover countries not listed.
+struct ImplicitLimit {
+  std::string_view country;  // empty = any country
+  std::string_view zone;
+  double kmh;
+};
+constexpr std::array<ImplicitLimit, 27> kImplicitLimits{{
+    {"gb", "nsl_single", 60 * kMphToKmh},
+    {"gb", "nsl_dual", 70 * kMphToKmh},
+    {"gb", "motorway", 70 * kMphToKmh},
+    {"uk", "nsl_single", 60 * kMphToKmh},
+    {"uk", "nsl_dual", 70 * kMphToKmh},
+    {"uk", "motorway", 70 * kMphToKmh},
+    {"ru", "urban", 60},
+    {"ru", "rural", 90},
+    {"ru", "motorway", 110},
+    {"de", "rural", 100},
+    {"de", "motorway", 130},  // advisory speed where there is no limit
+    {"at", "rural", 100},
+    {"fr", "rural", 80},
+    {"ch", "rural", 80},
+    {"ch", "motorway", 120},
+    {"ch", "trunk", 100},
+    {"it", "rural", 90},
+    {"it", "trunk", 110},
+    {"us", "urban", 25 * kMphToKmh},
+    {"", "urban", 50},
+    {"", "rural", 90},
+    {"", "motorway", 130},
+    {"", "trunk", 100},
+    {"", "living_street", 7},
+    {"", "bicycle_road", 30},
+    {"", "walk", kWalkKmh},
+    {"", "school", 30},
+}};
+
+std::optional<double> parse_number_with_unit(std::string_view s) {
+  double value = 0.0;
+  const char* begin = s.data();
+  const char* end = s.data() + s.size();
+  auto [ptr, ec] = std::from_chars(begin, end, value);
+  if (ec != std::errc{} || !(value > 0.0) || value > 500.0) return std::nullopt;
+  const std::string unit = lower(trim(std::string_view(ptr, static_cast<std::size_t>(end - ptr))));
+  if (unit.empty() || unit == "km/h" || unit == "kmh" || unit == "kph") return value;
+  if (unit == "mph") return value * kMphToKmh;
+  if (unit == "knots") return value * kKnotToKmh;
+  return std::nullopt;
+}
+
+std::optional<double> parse_implicit(std::string_view country, std::string_view zone) {
+  // DE:zone30, DE:zone:30, FR:zone30 and the like carry their number.
+  for (std::string_view prefix : {"zone:", "zone"}) {
+    if (zone.starts_with(prefix)) {
+      if (auto v = parse_number_with_unit(zone.substr(prefix.size()))) return v;
+    }
+  }
+  for (const auto& limit : kImplicitLimits) {
+    if (limit.country == country && limit.zone == zone) return limit.kmh;
+  }
+  for (const auto& limit : kImplicitLimits) {
+    if (limit.country.empty() && limit.zone == zone) return limit.kmh;
+  }
+  return std::nullopt;
+}
+
+enum class OnewayRule { both, forward, backward, unusable, unspecified };
+
+OnewayRule parse_oneway(std::string_view v) {
+  if (v.empty()) return OnewayRule::unspecified;
+  if (is_one_of(v, {"yes", "true", "1"})) return OnewayRule::forward;
+  if (is_one_of(v, {"-1", "reverse"})) return OnewayRule::backward;
+  if (is_one_of(v, {"no", "false", "0", "alternating"})) return OnewayRule::both;
+  if (v == "reversible") return OnewayRule::unusable;
+  return OnewayRule::unspecified;
+}
+
+bool access_forbids(std::string_view v) {
+  return is_one_of(v, {"no", "agricultural", "forestry", "emergency_no", "use_sidepath", "discouraged"});
+}
+
+}  // namespace
+
+std::optional<double> parse_maxspeed_kmh(std::string_view raw) {
+  std::string_view v = trim(raw);
+  if (const auto semi = v.find(';'); semi != std::string_view::npos) v = trim(v.substr(0, semi));
+  if (v.empty()) return std::nullopt;
+  const std::string lv = lower(v);
+  if (lv == "none") return kNoLimitKmh;
+  if (lv == "walk") return kWalkKmh;
+  if (auto number = parse_number_with_unit(lv)) return number;
+  if (const auto colon = lv.find(':'); colon != std::string::npos && colon > 0) {
+    return parse_implicit(std::string_view(lv).substr(0, colon), std::string_view(lv).substr(colon + 1));
+  }
+  return std::nullopt;
+}
+
+double default_speed_kmh(RoadClass c) {
+  switch (c) {
+    case RoadClass::motorway: return 110;
+    case RoadClass::motorway_link: return 60;
+    case RoadClass::trunk: return 90;
+    case RoadClass::trunk_link: return 50;
+    case RoadClass::primary: return 65;
+    case RoadClass::primary_link: return 45;
+    case RoadClass::secondary: return 55;
+    case RoadClass::secondary_link: return 40;
+    case RoadClass::tertiary: return 45;
+    case RoadClass::tertiary_link: return 35;
+    case RoadClass::unclassified: return 40;
+    case RoadClass::residential: return 30;
+    case RoadClass::living_street: return 10;
+    case RoadClass::service: return 20;
+    case RoadClass::emergency_access: return 20;
+    case RoadClass::synthetic: return 50;
+  }
+  return 30;
+}
+
+std::optional<WayRules> interpret_way(const WayTags& t) {
+  if (t.highway.empty() || t.area == "yes") return std::nullopt;
+  const bool emergency_allowed = is_one_of(t.emergency, {"yes", "designated", "official", "permissive"});
+  if (t.emergency == "no") return std::nullopt;
+
+  WayRules rules;
+  if (auto cls = road_class_from_highway(t.highway)) {
+    rules.road_class = *cls;
+  } else if (emergency_allowed) {
+    rules.road_class = RoadClass::emergency_access;
+  } else {
+    return std::nullopt;
+  }
+
+  if (!emergency_allowed) {
+    // The most specific access tag present decides.
+    for (std::string_view v : {t.motorcar, t.motor_vehicle, t.vehicle, t.access}) {
+      if (v.empty()) continue;
+      if (access_forbids(v)) return std::nullopt;
+      break;
+    }
+  }
+
+  OnewayRule oneway = parse_oneway(t.oneway);
+  if (oneway == OnewayRule::unspecified) {
+    const bool implied = t.junction == "roundabout" || t.junction == "circular" ||
+                         rules.road_class == RoadClass::motorway;
+    oneway = implied ? OnewayRule::forward : OnewayRule::both;
+  }
+  if (oneway == OnewayRule::unusable) return std::nullopt;
+  if (t.oneway_emergency == "no") oneway = OnewayRule::both;
+  rules.forward = oneway != OnewayRule::backward;
+  rules.backward = oneway != OnewayRule::forward;
+
+  const double fallback = parse_maxspeed_kmh(t.maxspeed).value_or(default_speed_kmh(rules.road_class));
+  rules.forward_speed_kmh = parse_maxspeed_kmh(t.maxspeed_forward).value_or(fallback);
+  rules.backward_speed_kmh = parse_maxspeed_kmh(t.maxspeed_backward).value_or(fallback);
+  return rules;
+}
+
+}  // namespace corridor::maps

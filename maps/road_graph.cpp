@@ -1,0 +1,100 @@
+#include "maps/road_graph.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "maps/errors.hpp"
+
+namespace corridor::maps {
+namespace {
+
+void require(bool ok, const char* what) {
+  if (!ok) throw MapError(std::string("inconsistent road graph: ") + what);
+}
+
+void validate(const RoadGraphData& d) {
+  const std::size_t n = d.node_x_m.size();
+  const std::size_t m = d.edge_head.size();
+  require(n < std::numeric_limits<std::uint32_t>::max() && m < std::numeric_limits<std::uint32_t>::max(),
+          "too many nodes or edges for 32-bit ids");
+  require(d.node_y_m.size() == n && d.node_osm_id.size() == n && d.node_signalized.size() == n,
+          "node arrays differ in length");
+  require(d.first_out.size() == n + 1 && d.first_in.size() == n + 1, "CSR offsets have the wrong length");
+  require(d.edge_tail.size() == m && d.edge_length_m.size() == m && d.edge_speed_mps.size() == m &&
+              d.edge_osm_way.size() == m && d.edge_class.size() == m && d.edge_twin.size() == m &&
+              d.in_edge.size() == m && d.geometry_first.size() == m + 1,
+          "edge arrays differ in length");
+  require(d.first_out.front() == 0 && d.first_out.back() == m, "forward CSR does not cover all edges");
+  require(d.first_in.front() == 0 && d.first_in.back() == m, "reverse CSR does not cover all edges");
+  require(d.geometry_first.front() == 0 && d.geometry_first.back() == d.geometry.size(),
+          "geometry offsets do not cover the geometry");
+  for (std::size_t u = 0; u < n; ++u) {
+    require(d.first_out[u] <= d.first_out[u + 1] && d.first_in[u] <= d.first_in[u + 1], "CSR offsets decrease");
+    require(std::isfinite(d.node_x_m[u]) && std::isfinite(d.node_y_m[u]), "node coordinate is not finite");
+    for (auto e = d.first_out[u]; e < d.first_out[u + 1]; ++e) {
+      require(d.edge_tail[e].index() == u, "edge tail disagrees with the forward CSR");
+    }
+    for (auto i = d.first_in[u]; i < d.first_in[u + 1]; ++i) {
+      require(d.in_edge[i].index() < m && d.edge_head[d.in_edge[i].index()].index() == u,
+              "edge head disagrees with the reverse CSR");
+    }
+  }
+  for (std::size_t e = 0; e < m; ++e) {
+    require(d.edge_head[e].index() < n, "edge head out of range");
+    require(std::isfinite(d.edge_length_m[e]) && d.edge_length_m[e] > 0.0, "edge length must be positive");
+    require(std::isfinite(d.edge_speed_mps[e]) && d.edge_speed_mps[e] > 0.0f, "edge speed must be positive");
+    require(!d.edge_twin[e].valid() || d.edge_twin[e].index() < m, "edge twin out of range");
+    require(d.geometry_first[e] + 2 <= d.geometry_first[e + 1], "edge geometry needs at least two points");
+  }
+}
+
+}  // namespace
+
+void build_reverse_adjacency(RoadGraphData& d) {
+  const std::size_t n = d.node_x_m.size();
+  d.first_in.assign(n + 1, 0);
+  for (NodeId v : d.edge_head) ++d.first_in[v.index() + 1];
+  for (std::size_t v = 0; v < n; ++v) d.first_in[v + 1] += d.first_in[v];
+  d.in_edge.assign(d.edge_head.size(), kInvalidEdge);
+  std::vector<std::uint32_t> fill(d.first_in.begin(), d.first_in.end() - 1);
+  for (std::uint32_t e = 0; e < d.edge_head.size(); ++e) d.in_edge[fill[d.edge_head[e].index()]++] = EdgeId{e};
+}
+
+RoadGraph::RoadGraph(RoadGraphData data) : data_(std::move(data)), projection_(data_.origin) {
+  validate(data_);
+  double scale = 1.0;
+  for (std::size_t e = 0; e < edge_count(); ++e) {
+    const double chord = distance_m(position(data_.edge_tail[e]), position(data_.edge_head[e]));
+    if (chord > 0.0) scale = std::min(scale, data_.edge_length_m[e] / chord);
+  }
+  // A hair below the true ratio so that rounding in the length sums can never make h inconsistent.
+  heuristic_scale_ = scale * (1.0 - 1e-9);
+
+  if (node_count() > 0) {
+    min_corner_ = max_corner_ = position(NodeId{0});
+    for (const Point2& p : data_.geometry) {
+      min_corner_ = {std::min(min_corner_.x_m, p.x_m), std::min(min_corner_.y_m, p.y_m)};
+      max_corner_ = {std::max(max_corner_.x_m, p.x_m), std::max(max_corner_.y_m, p.y_m)};
+    }
+  }
+}
+
+Point2 RoadGraph::point_along(EdgeId e, double offset_m) const {
+  const auto pts = geometry(e);
+  double geometric = 0.0;
+  for (std::size_t i = 1; i < pts.size(); ++i) geometric += distance_m(pts[i - 1], pts[i]);
+  // Offsets are in units of the edge's stated length; geometry may be drawn shorter or longer.
+  double remaining = std::clamp(offset_m, 0.0, length_m(e)) * (geometric / length_m(e));
+  for (std::size_t i = 1; i < pts.size(); ++i) {
+    const double seg = distance_m(pts[i - 1], pts[i]);
+    if (remaining <= seg && seg > 0.0) {
+      const double t = remaining / seg;
+      return {pts[i - 1].x_m + t * (pts[i].x_m - pts[i - 1].x_m), pts[i - 1].y_m + t * (pts[i].y_m - pts[i - 1].y_m)};
+    }
+    remaining -= seg;
+  }
+  return pts.back();
+}
+
+}  // namespace corridor::maps

@@ -1,0 +1,104 @@
+// The immutable road graph: forward and reverse adjacency as CSR arrays, with per-edge attributes
+// and geometry in the map's local metric frame.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "maps/geo.hpp"
+#include "maps/ids.hpp"
+#include "maps/road_class.hpp"
+
+namespace corridor::maps {
+
+// Plain arrays, as built by the importer and as stored in the cache. RoadGraph validates them once.
+struct RoadGraphData {
+  LatLon origin;  // centre of the local projection
+
+  // Per node.
+  std::vector<double> node_x_m;
+  std::vector<double> node_y_m;
+  std::vector<OsmNodeId> node_osm_id;
+  std::vector<std::uint8_t> node_signalized;  // 1 when the intersection has traffic signals
+
+  // Forward CSR: the out-edges of node u are [first_out[u], first_out[u+1]).
+  std::vector<std::uint32_t> first_out;
+  std::vector<NodeId> edge_tail;
+  std::vector<NodeId> edge_head;
+  std::vector<double> edge_length_m;
+  std::vector<float> edge_speed_mps;  // legal / free-flow speed
+  std::vector<OsmWayId> edge_osm_way;
+  std::vector<RoadClass> edge_class;
+  std::vector<EdgeId> edge_twin;  // the same road in the opposite direction, or invalid
+
+  // Geometry: edge e's polyline is geometry[geometry_first[e] .. geometry_first[e+1]), tail to head.
+  std::vector<std::uint32_t> geometry_first;
+  std::vector<Point2> geometry;
+
+  // Reverse CSR: the in-edges of node v are in_edge[first_in[v] .. first_in[v+1]).
+  std::vector<std::uint32_t> first_in;
+  std::vector<EdgeId> in_edge;
+};
+
+class RoadGraph {
+ public:
+  // Throws MapError when the arrays are inconsistent (for example, a corrupt cache).
+  explicit RoadGraph(RoadGraphData data);
+
+  [[nodiscard]] std::size_t node_count() const { return data_.node_x_m.size(); }
+  [[nodiscard]] std::size_t edge_count() const { return data_.edge_head.size(); }
+  [[nodiscard]] IdRange<NodeId> nodes() const { return {0, static_cast<std::uint32_t>(node_count())}; }
+  [[nodiscard]] IdRange<EdgeId> edges() const { return {0, static_cast<std::uint32_t>(edge_count())}; }
+
+  [[nodiscard]] IdRange<EdgeId> out_edges(NodeId u) const {
+    return {data_.first_out[u.index()], data_.first_out[u.index() + 1]};
+  }
+  [[nodiscard]] std::span<const EdgeId> in_edges(NodeId v) const {
+    return {data_.in_edge.data() + data_.first_in[v.index()], data_.first_in[v.index() + 1] - data_.first_in[v.index()]};
+  }
+
+  [[nodiscard]] NodeId tail(EdgeId e) const { return data_.edge_tail[e.index()]; }
+  [[nodiscard]] NodeId head(EdgeId e) const { return data_.edge_head[e.index()]; }
+  [[nodiscard]] double length_m(EdgeId e) const { return data_.edge_length_m[e.index()]; }
+  [[nodiscard]] double speed_mps(EdgeId e) const { return data_.edge_speed_mps[e.index()]; }
+  [[nodiscard]] OsmWayId osm_way(EdgeId e) const { return data_.edge_osm_way[e.index()]; }
+  [[nodiscard]] RoadClass road_class(EdgeId e) const { return data_.edge_class[e.index()]; }
+  [[nodiscard]] EdgeId twin(EdgeId e) const { return data_.edge_twin[e.index()]; }
+  [[nodiscard]] std::span<const Point2> geometry(EdgeId e) const {
+    const auto b = data_.geometry_first[e.index()];
+    return {data_.geometry.data() + b, data_.geometry_first[e.index() + 1] - b};
+  }
+
+  [[nodiscard]] Point2 position(NodeId u) const { return {data_.node_x_m[u.index()], data_.node_y_m[u.index()]}; }
+  [[nodiscard]] OsmNodeId osm_node(NodeId u) const { return data_.node_osm_id[u.index()]; }
+  [[nodiscard]] bool signalized(NodeId u) const { return data_.node_signalized[u.index()] != 0; }
+
+  // The point at `offset_m` along edge e (clamped to the edge).
+  [[nodiscard]] Point2 point_along(EdgeId e, double offset_m) const;
+
+  [[nodiscard]] const LocalProjection& projection() const { return projection_; }
+  [[nodiscard]] const RoadGraphData& data() const { return data_; }
+
+  // Lower bound of length / straight-line distance over all edges, at most 1. Scaling the
+  // straight-line heuristic by it keeps A* and D* Lite admissible even where an edge's stated length
+  // is shorter than the chord between its end nodes (SUMO nets).
+  [[nodiscard]] double heuristic_scale() const { return heuristic_scale_; }
+
+  // Bounding box in the local frame.
+  [[nodiscard]] Point2 min_corner() const { return min_corner_; }
+  [[nodiscard]] Point2 max_corner() const { return max_corner_; }
+
+ private:
+  RoadGraphData data_;
+  LocalProjection projection_;
+  double heuristic_scale_ = 1.0;
+  Point2 min_corner_;
+  Point2 max_corner_;
+};
+
+// Fills first_in / in_edge from the forward arrays.
+void build_reverse_adjacency(RoadGraphData& data);
+
+}  // namespace corridor::maps

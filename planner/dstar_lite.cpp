@@ -1,0 +1,152 @@
+#include "planner/dstar_lite.hpp"
+
+#include <algorithm>
+
+namespace corridor::planner {
+
+DStarLite::DStarLite(const TravelCost& cost, std::vector<EdgePoint> starts, std::vector<EdgePoint> goals)
+    : space_(cost, std::move(starts), std::move(goals)),
+      g_(space_.vertex_count(), kInfCost),
+      rhs_(space_.vertex_count(), kInfCost),
+      open_(space_.vertex_count()),
+      last_start_pos_(space_.position(space_.start())) {
+  // Initialize(): the search runs backward, so it starts at the goal. (Koenig & Likhachev Fig. 4)
+  const Vertex goal = space_.goal();
+  rhs_[goal.index()] = 0.0;
+  open_.push_or_update(goal.v, calculate_key(goal));
+}
+
+DStarLite::Key DStarLite::calculate_key(Vertex s) const {
+  const double m = std::min(g_[s.index()], rhs_[s.index()]);
+  return {add_cost(add_cost(m, space_.heuristic_s(space_.start(), s)), km_), m};
+}
+
+double DStarLite::min_successor_cost(Vertex u) const {
+  double best = kInfCost;
+  space_.for_each_successor(u, [&](Vertex v, double c, EdgeId) { best = std::min(best, add_cost(c, g_[v.index()])); });
+  return best;
+}
+
+void DStarLite::update_vertex(Vertex u) {
+  if (g_[u.index()] != rhs_[u.index()]) {
+    open_.push_or_update(u.v, calculate_key(u));
+  } else {
+    open_.remove(u.v);
+  }
+}
+
+void DStarLite::recompute_rhs(Vertex u) {
+  if (u == space_.goal()) return;
+  rhs_[u.index()] = min_successor_cost(u);
+  update_vertex(u);
+}
+
+void DStarLite::move_start(std::vector<EdgePoint> starts) {
+  space_.set_starts(std::move(starts));
+  // km grows by h(s_last, s_start) so that keys already queued stay lower bounds (paper line 38'').
+  const maps::Point2 now = space_.position(space_.start());
+  km_ = add_cost(km_, space_.cost().heuristic_s(last_start_pos_, now));
+  last_start_pos_ = now;
+  recompute_rhs(space_.start());
+}
+
+void DStarLite::edges_changed(std::span<const EdgeId> edges) {
+  const auto& graph = space_.cost().graph();
+  bool start_affected = false;
+  for (EdgeId e : edges) {
+    // Every arc whose cost can depend on e starts at e's tail (graph arc and goal arc) or at S.
+    recompute_rhs(SearchSpace::vertex(graph.tail(e)));
+    start_affected = start_affected || space_.is_start_edge(e);
+  }
+  if (start_affected) recompute_rhs(space_.start());
+}
+
+void DStarLite::nodes_changed(std::span<const NodeId> nodes) {
+  // A node's crossing delay is part of every arc out of it, and of no other arc.
+  for (NodeId n : nodes) recompute_rhs(SearchSpace::vertex(n));
+}
+
+ReplanStats DStarLite::replan() {
+  ReplanStats stats;
+  const Vertex start = space_.start();
+  const Vertex goal = space_.goal();
+  while (!open_.empty() &&
+         (open_.top_key() < calculate_key(start) || rhs_[start.index()] > g_[start.index()])) {
+    const Vertex u{open_.top()};
+    const Key k_old = open_.top_key();
+    const Key k_new = calculate_key(u);
+    ++stats.expanded;
+    if (k_old < k_new) {
+      open_.push_or_update(u.v, k_new);
+    } else if (g_[u.index()] > rhs_[u.index()]) {
+      // Overconsistent: settle u and relax its predecessors.
+      g_[u.index()] = rhs_[u.index()];
+      open_.remove(u.v);
+      const double gu = g_[u.index()];
+      space_.for_each_predecessor(u, [&](Vertex s, double c) {
+        if (s == goal) return;
+        const double via_u = add_cost(c, gu);
+        if (via_u < rhs_[s.index()]) {
+          rhs_[s.index()] = via_u;
+          update_vertex(s);
+          ++stats.updated;
+        }
+      });
+    } else {
+      // Underconsistent: u's old value may have supported its predecessors; re-derive them.
+      const double g_old = g_[u.index()];
+      g_[u.index()] = kInfCost;
+      space_.for_each_predecessor(u, [&](Vertex s, double c) {
+        if (s != goal && rhs_[s.index()] == add_cost(c, g_old)) {
+          rhs_[s.index()] = min_successor_cost(s);
+          ++stats.updated;
+        }
+        update_vertex(s);
+      });
+      // rhs(u) depends only on u's successors, which did not change: it stays valid.
+      update_vertex(u);
+    }
+  }
+  return stats;
+}
+
+Route DStarLite::route() const {
+  const Vertex start = space_.start();
+  const Vertex goal = space_.goal();
+  Route none;
+  none.start = space_.starts().front();
+  none.goal = space_.goals().front();
+  if (g_[start.index()] >= kInfCost && rhs_[start.index()] >= kInfCost) return none;
+
+  std::vector<EdgeId> edges;
+  Vertex u = start;
+  // Every arc costs more than zero except S arcs, so a path has at most vertex_count arcs.
+  for (std::size_t steps = 0; u != goal && steps < space_.vertex_count(); ++steps) {
+    double best = kInfCost;
+    Vertex next;
+    EdgeId via;
+    space_.for_each_successor(u, [&](Vertex v, double c, EdgeId e) {
+      const double total = add_cost(c, v == goal ? 0.0 : g_[v.index()]);
+      if (total < best) {
+        best = total;
+        next = v;
+        via = e;
+      }
+    });
+    if (!next.valid()) return none;
+    edges.push_back(via);
+    u = next;
+  }
+  if (u != goal) return none;
+  EdgePoint s = space_.starts().front();
+  for (const EdgePoint& p : space_.starts()) {
+    if (p.edge == edges.front()) s = p;
+  }
+  EdgePoint t = space_.goals().front();
+  for (const EdgePoint& p : space_.goals()) {
+    if (p.edge == edges.back()) t = p;
+  }
+  return make_route(space_.cost(), s, std::move(edges), t);
+}
+
+}  // namespace corridor::planner

@@ -1,0 +1,63 @@
+// D* Lite (Koenig & Likhachev 2002, optimized version with key modifier km): one vehicle's route,
+// searched backward from the goal and repaired incrementally as costs change and the vehicle moves.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "planner/indexed_heap.hpp"
+#include "planner/one_to_one_search.hpp"
+#include "planner/route.hpp"
+#include "planner/search_space.hpp"
+
+namespace corridor::planner {
+
+struct ReplanStats {
+  std::uint64_t expanded = 0;  // vertices taken off the queue
+  std::uint64_t updated = 0;   // UpdateVertex calls
+};
+
+class DStarLite {
+ public:
+  // `cost` must outlive the planner. The caller changes the CostOverlay behind it and then reports
+  // the changed ids through edges_changed / nodes_changed before the next replan().
+  DStarLite(const TravelCost& cost, std::vector<EdgePoint> starts, std::vector<EdgePoint> goals);
+
+  // The vehicle has moved. Cheap: the repair happens in replan().
+  void move_start(std::vector<EdgePoint> starts);
+  void edges_changed(std::span<const EdgeId> edges);
+  void nodes_changed(std::span<const NodeId> nodes);
+
+  // ComputeShortestPath: brings the plan up to date with all reported changes.
+  ReplanStats replan();
+
+  // Cost from the vehicle to the goal (kInfCost when unreachable); valid after replan().
+  // rhs, not g: S has no predecessors, so the search may stop with S overconsistent.
+  [[nodiscard]] double cost_to_goal_s() const { return rhs_[space_.start().index()]; }
+  // The current route, extracted greedily from the g values; valid after replan().
+  [[nodiscard]] Route route() const;
+
+  [[nodiscard]] const SearchSpace& space() const { return space_; }
+
+ private:
+  struct Key {
+    double k1;
+    double k2;
+    friend bool operator<(const Key& a, const Key& b) { return a.k1 < b.k1 || (a.k1 == b.k1 && a.k2 < b.k2); }
+  };
+
+  [[nodiscard]] Key calculate_key(Vertex s) const;
+  [[nodiscard]] double min_successor_cost(Vertex u) const;
+  void update_vertex(Vertex u);
+  void recompute_rhs(Vertex u);
+
+  SearchSpace space_;
+  std::vector<double> g_;
+  std::vector<double> rhs_;
+  IndexedHeap<Key> open_;
+  double km_ = 0.0;
+  maps::Point2 last_start_pos_;
+};
+
+}  // namespace corridor::planner

@@ -1,0 +1,101 @@
+// A binary min-heap over dense vertex ids with decrease-, increase-key and removal, as D* Lite's
+// open list needs. Keys are compared with operator<.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <utility>
+#include <vector>
+
+namespace corridor::planner {
+
+template <class Key>
+class IndexedHeap {
+ public:
+  static constexpr std::uint32_t kAbsent = std::numeric_limits<std::uint32_t>::max();
+
+  explicit IndexedHeap(std::size_t id_count = 0) : pos_(id_count, kAbsent) {}
+
+  [[nodiscard]] bool empty() const { return heap_.empty(); }
+  [[nodiscard]] std::size_t size() const { return heap_.size(); }
+  [[nodiscard]] bool contains(std::uint32_t id) const { return pos_[id] != kAbsent; }
+  [[nodiscard]] const Key& top_key() const { return heap_.front().key; }
+  [[nodiscard]] std::uint32_t top() const { return heap_.front().id; }
+
+  // Inserts, or changes the key of an id already present.
+  void push_or_update(std::uint32_t id, const Key& key) {
+    if (pos_[id] == kAbsent) {
+      pos_[id] = static_cast<std::uint32_t>(heap_.size());
+      heap_.push_back({key, id});
+      sift_up(pos_[id]);
+      return;
+    }
+    const std::uint32_t i = pos_[id];
+    const bool decreased = key < heap_[i].key;
+    heap_[i].key = key;
+    if (decreased) {
+      sift_up(i);
+    } else {
+      sift_down(i);
+    }
+  }
+
+  void remove(std::uint32_t id) {
+    const std::uint32_t i = pos_[id];
+    if (i == kAbsent) return;
+    pos_[id] = kAbsent;
+    if (i + 1 == heap_.size()) {
+      heap_.pop_back();
+      return;
+    }
+    heap_[i] = heap_.back();
+    heap_.pop_back();
+    pos_[heap_[i].id] = i;
+    sift_down(i);
+    sift_up(pos_[heap_[i].id] == i ? i : pos_[heap_[i].id]);
+  }
+
+  void clear() {
+    for (const auto& entry : heap_) pos_[entry.id] = kAbsent;
+    heap_.clear();
+  }
+
+ private:
+  struct Entry {
+    Key key;
+    std::uint32_t id;
+  };
+
+  void place(std::uint32_t i, Entry e) {
+    pos_[e.id] = i;
+    heap_[i] = std::move(e);
+  }
+  void sift_up(std::uint32_t i) {
+    Entry e = heap_[i];
+    while (i > 0) {
+      const std::uint32_t parent = (i - 1) / 2;
+      if (!(e.key < heap_[parent].key)) break;
+      place(i, heap_[parent]);
+      i = parent;
+    }
+    place(i, e);
+  }
+  void sift_down(std::uint32_t i) {
+    Entry e = heap_[i];
+    const auto n = static_cast<std::uint32_t>(heap_.size());
+    while (true) {
+      std::uint32_t child = 2 * i + 1;
+      if (child >= n) break;
+      if (child + 1 < n && heap_[child + 1].key < heap_[child].key) ++child;
+      if (!(heap_[child].key < e.key)) break;
+      place(i, heap_[child]);
+      i = child;
+    }
+    place(i, e);
+  }
+
+  std::vector<Entry> heap_;
+  std::vector<std::uint32_t> pos_;
+};
+
+}  // namespace corridor::planner

@@ -1,0 +1,37 @@
+// A planned route: the edges driven from a start point to a goal point, with the predicted arrival
+// time at every intersection on the way (which preemption needs), and its geometry.
+#pragma once
+
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "maps/geo.hpp"
+#include "planner/travel_cost.hpp"
+
+namespace corridor::planner {
+
+struct Route {
+  bool found = false;
+  double travel_time_s = kInfCost;
+  double length_m = 0.0;
+  EdgePoint start;
+  EdgePoint goal;
+  std::vector<EdgeId> edges;      // edges.front() == start.edge, edges.back() == goal.edge
+  std::vector<NodeId> nodes;      // intersections crossed, nodes[i] = head(edges[i])
+  std::vector<double> arrival_s;  // from now until the vehicle reaches nodes[i]'s stop line
+
+  // Remaining travel time from arriving at `node` to the goal, if the route crosses it.
+  [[nodiscard]] std::optional<double> cost_to_goal_s(NodeId node) const;
+};
+
+// Evaluates driving `edges` (first = start.edge, last = goal.edge) under the current costs.
+Route make_route(const TravelCost& cost, EdgePoint start, std::vector<EdgeId> edges, EdgePoint goal);
+
+// The route's polyline in the local frame, clipped at the start and goal offsets.
+std::vector<maps::Point2> route_polyline(const maps::RoadGraph& graph, const Route& route);
+
+// The part of edge e between two offsets, as a polyline.
+std::vector<maps::Point2> edge_polyline(const maps::RoadGraph& graph, EdgeId e, double from_m, double to_m);
+
+}  // namespace corridor::planner

@@ -1,0 +1,60 @@
+// The planner's cost model: edge travel time from length, speed, vehicle max speed, congestion and
+// queue delay; node crossing delay; and the admissible straight-line heuristic.
+#pragma once
+
+#include <algorithm>
+
+#include "maps/road_graph.hpp"
+#include "planner/cost.hpp"
+#include "planner/cost_overlay.hpp"
+
+namespace corridor::planner {
+
+struct VehicleProfile {
+  double vmax_mps = 120.0 / 3.6;
+};
+
+// A point on a directed edge, `offset_m` from its tail in the edge's length units.
+struct EdgePoint {
+  EdgeId edge;
+  double offset_m = 0.0;
+};
+
+class TravelCost {
+ public:
+  // Throws CostUpdateError when vmax is not a positive finite speed.
+  TravelCost(const maps::RoadGraph& graph, const CostOverlay& overlay, VehicleProfile vehicle);
+
+  // length / min(edge speed, vmax) × congestion factor, but never faster than vmax allows: a factor
+  // below 1 cannot make the vehicle outrun itself, which keeps the heuristic admissible.
+  [[nodiscard]] double running_time_s(EdgeId e) const {
+    const double length = graph_->length_m(e);
+    const double free_flow = length / std::min(graph_->speed_mps(e), vmax_mps_);
+    return std::max(free_flow * overlay_->edge(e).congestion_factor, length / vmax_mps_);
+  }
+  [[nodiscard]] double edge_time_s(EdgeId e) const { return add_cost(running_time_s(e), overlay_->edge(e).queue_delay_s); }
+  [[nodiscard]] double node_delay_s(NodeId v) const { return overlay_->node_delay_s(v); }
+
+  // Crossing the tail intersection, then driving the edge: the weight of a graph edge. Folding the
+  // node cost into its out-edges makes node costs exact for every path through the node.
+  [[nodiscard]] double transit_s(EdgeId e) const { return add_cost(node_delay_s(graph_->tail(e)), edge_time_s(e)); }
+
+  // Driving from offset `from_m` to `to_m` on e; the queue delay applies only when reaching the end.
+  [[nodiscard]] double partial_time_s(EdgeId e, double from_m, double to_m) const;
+
+  [[nodiscard]] double heuristic_s(maps::Point2 a, maps::Point2 b) const {
+    return maps::distance_m(a, b) * heuristic_scale_ / vmax_mps_;
+  }
+
+  [[nodiscard]] const maps::RoadGraph& graph() const { return *graph_; }
+  [[nodiscard]] const CostOverlay& overlay() const { return *overlay_; }
+  [[nodiscard]] double vmax_mps() const { return vmax_mps_; }
+
+ private:
+  const maps::RoadGraph* graph_;
+  const CostOverlay* overlay_;
+  double vmax_mps_;
+  double heuristic_scale_;
+};
+
+}  // namespace corridor::planner
