@@ -1,6 +1,7 @@
 #include "planner/dstar_lite.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 namespace corridor::planner {
 
@@ -70,8 +71,16 @@ ReplanStats DStarLite::replan() {
   ReplanStats stats;
   const Vertex start = space_.start();
   const Vertex goal = space_.goal();
-  while (!open_.empty() &&
-         (open_.top_key() < calculate_key(start) || rhs_[start.index()] > g_[start.index()])) {
+  // The paper stops once TopKey >= key(start). Here S's arcs can cost 0 (the vehicle exactly at a
+  // node), so an underconsistent successor of S can tie with S's key, and a stale key summed in
+  // another order (g + h(old, v) + km_old against g + km_new) can land an ulp above it. Processing
+  // such near-ties is always safe, and stopping before them leaves S with a stale value.
+  auto must_continue = [&] {
+    const Key ks = calculate_key(start);
+    const double slack = 1e-9 * std::max(1.0, std::abs(ks.k1));
+    return open_.top_key().k1 <= ks.k1 + slack || rhs_[start.index()] > g_[start.index()];
+  };
+  while (!open_.empty() && must_continue()) {
     const Vertex u{open_.top()};
     const Key k_old = open_.top_key();
     const Key k_new = calculate_key(u);
@@ -108,6 +117,22 @@ ReplanStats DStarLite::replan() {
     }
   }
   return stats;
+}
+
+std::string DStarLite::invariant_violation() const {
+  for (std::uint32_t i = 0; i < space_.vertex_count(); ++i) {
+    const Vertex u{i};
+    const double expected_rhs = u == space_.goal() ? 0.0 : min_successor_cost(u);
+    if (expected_rhs != rhs_[i]) {
+      return "vertex " + std::to_string(i) + ": rhs " + std::to_string(rhs_[i]) + " but successors give " +
+             std::to_string(expected_rhs);
+    }
+    if ((g_[i] != rhs_[i]) != open_.contains(i)) {
+      return "vertex " + std::to_string(i) + ": queued=" + std::to_string(open_.contains(i)) + " g=" +
+             std::to_string(g_[i]) + " rhs=" + std::to_string(rhs_[i]);
+    }
+  }
+  return {};
 }
 
 Route DStarLite::route() const {

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "planner/indexed_heap.hpp"
@@ -39,6 +40,10 @@ class DStarLite {
   [[nodiscard]] Route route() const;
 
   [[nodiscard]] const SearchSpace& space() const { return space_; }
+
+  // Checks D* Lite's invariants over every vertex: rhs(u) = min over successors of c + g, and a
+  // vertex is queued exactly when it is inconsistent. O(V + E); for tests. Empty when all hold.
+  [[nodiscard]] std::string invariant_violation() const;
 
  private:
   struct Key {
