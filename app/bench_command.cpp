@@ -54,6 +54,12 @@ void register_bench_command(CLI::App& app) {
   replan->add_option("--seed", o->config.seed, "random seed")->capture_default_str();
   replan->add_option("--drive-step-s", o->config.drive_step_s, "driving time between batches")->capture_default_str();
   replan->add_option("--vmax-kmh", o->config.vmax_kmh, "vehicle maximum speed")->capture_default_str();
+  replan->add_option("--on-route", o->config.on_route_fraction, "share of updates on the current route")
+      ->capture_default_str();
+  replan->add_option("--near-route", o->config.near_route_fraction, "share on edges touching the route")
+      ->capture_default_str();
+  replan->add_option("--clearing", o->config.clearing_fraction, "share that clear congestion (cost decreases)")
+      ->capture_default_str();
   replan->add_option("--min-trip-m", o->config.min_trip_m, "minimum straight-line trip length (0 = auto)");
   replan->add_flag("!--no-dijkstra", o->config.run_dijkstra, "skip the Dijkstra baseline (and the mismatch check)");
   replan->callback([o] { run_replan(*o); });

@@ -73,20 +73,39 @@ class UpdateGenerator {
     return out;
   }
 
-  // Slower (congestion, queues, rarely a closure) or faster (congestion clearing).
-  planner::EdgeCondition condition() {
+  // Applies one update to `e`: slower (congestion, queues, rarely a closure) or, for an edge that is
+  // congested, faster (congestion clearing, partly or fully). Returns the edge actually changed.
+  EdgeId apply(EdgeId e, planner::CostOverlay& overlay) {
     std::uniform_real_distribution<double> unit(0.0, 1.0);
     const double r = unit(rng_);
-    if (r < 0.03) return {planner::kInfCost, 0.0};
-    if (r < 0.6) return {1.0 + 3.0 * unit(rng_), unit(rng_) < 0.5 ? 60.0 * unit(rng_) : 0.0};
-    if (r < 0.8) return {};
-    return {0.6 + 0.4 * unit(rng_), 0.0};
+    if (r < config_.clearing_fraction && !congested_.empty()) {
+      const std::size_t i = std::uniform_int_distribution<std::size_t>(0, congested_.size() - 1)(rng_);
+      e = congested_[i];
+      if (unit(rng_) < 0.5) {
+        overlay.reset_edge(e);
+        congested_[i] = congested_.back();
+        congested_.pop_back();
+      } else {
+        const planner::EdgeCondition c = overlay.edge(e);
+        const double factor = std::isfinite(c.congestion_factor) ? 1.0 + (c.congestion_factor - 1.0) * 0.5 : 2.0;
+        overlay.set_edge(e, {factor, c.queue_delay_s * 0.5});
+      }
+      return e;
+    }
+    if (r < config_.clearing_fraction + 0.03) {
+      overlay.close_edge(e);
+    } else {
+      overlay.set_edge(e, {1.0 + 3.0 * unit(rng_), unit(rng_) < 0.5 ? 60.0 * unit(rng_) : 0.0});
+    }
+    congested_.push_back(e);
+    return e;
   }
 
  private:
   const maps::RoadGraph& graph_;
   const ReplanBenchConfig& config_;
   std::mt19937_64& rng_;
+  std::vector<EdgeId> congested_;  // may hold duplicates; clearing an edge twice is harmless
 };
 
 }  // namespace
@@ -111,14 +130,16 @@ LatencySummary summarize_ms(std::vector<double> samples) {
 
 ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBenchConfig& config) {
   if (config.trips == 0) throw std::invalid_argument("--trips must be at least 1");
-  if (config.on_route_fraction < 0 || config.near_route_fraction < 0 ||
+  if (!(config.on_route_fraction >= 0) || !(config.near_route_fraction >= 0) ||
       config.on_route_fraction + config.near_route_fraction > 1.0) {
-    throw std::invalid_argument("update fractions must be >= 0 and sum to at most 1");
+    throw std::invalid_argument("--on-route and --near-route fractions must be >= 0 and sum to at most 1");
+  }
+  if (!(config.clearing_fraction >= 0) || config.clearing_fraction > 0.97) {
+    throw std::invalid_argument("--clearing fraction must be in [0, 0.97]");
   }
   if (!(config.drive_step_s > 0)) throw std::invalid_argument("drive step must be positive");
 
   std::mt19937_64 rng(config.seed);
-  UpdateGenerator updates(graph, config, rng);
   const double diagonal = maps::distance_m(graph.min_corner(), graph.max_corner());
   const double min_trip = config.min_trip_m > 0 ? config.min_trip_m : std::min(5000.0, diagonal / 3.0);
   const planner::VehicleProfile vehicle{config.vmax_kmh / 3.6};
@@ -127,7 +148,7 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
   res.nodes = graph.node_count();
   res.edges = graph.edge_count();
   std::vector<double> t_dstar, t_astar, t_dijkstra, t_dstar0, t_astar0;
-  double expanded = 0, astar_settled = 0, dijkstra_settled = 0;
+  double expanded = 0, rekeyed = 0, raised = 0, astar_settled = 0, dijkstra_settled = 0;
   planner::OneToOneSearch astar, dijkstra;
   std::uniform_int_distribution<std::uint32_t> any_edge(0, static_cast<std::uint32_t>(graph.edge_count() - 1));
   maps::ProgressBar progress("bench replan", config.trips);
@@ -135,6 +156,7 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
   for (std::uint32_t trip = 0; trip < config.trips; ++trip) {
     planner::CostOverlay overlay(graph);
     const planner::TravelCost cost(graph, overlay, vehicle);
+    UpdateGenerator updates(graph, config, rng);
     EdgePoint start, goal;
     for (int attempt = 0;; ++attempt) {
       start = {EdgeId{any_edge(rng)}, 0.0};
@@ -165,8 +187,8 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
       changed_set.clear();
       std::vector<EdgeId> changed;
       for (EdgeId e : updates.pick(route)) {
-        overlay.set_edge(e, updates.condition());
-        if (changed_set.insert(e.v).second) changed.push_back(e);
+        const EdgeId touched = updates.apply(e, overlay);
+        if (changed_set.insert(touched.v).second) changed.push_back(touched);
       }
 
       t0 = Clock::now();
@@ -176,6 +198,8 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
       planner::Route next = dstar.route();
       t_dstar.push_back(ms_since(t0));
       expanded += static_cast<double>(stats.expanded);
+      rekeyed += static_cast<double>(stats.rekeyed);
+      raised += static_cast<double>(stats.underconsistent);
 
       const planner::SearchSpace space(cost, {*position}, {goal});
       planner::SearchStats s_astar, s_dijkstra;
@@ -213,6 +237,8 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
   res.astar_initial = summarize_ms(t_astar0);
   const double n = res.replans > 0 ? static_cast<double>(res.replans) : 1.0;
   res.dstar_mean_expanded = expanded / n;
+  res.dstar_mean_rekeyed = rekeyed / n;
+  res.dstar_mean_raised = raised / n;
   res.astar_mean_settled = astar_settled / n;
   res.dijkstra_mean_settled = dijkstra_settled / n;
   return res;
@@ -230,10 +256,16 @@ nlohmann::json to_json(const ReplanBenchResult& r, const ReplanBenchConfig& c) {
   j["updates_per_batch"] = c.updates_per_batch;
   j["seed"] = c.seed;
   j["drive_step_s"] = c.drive_step_s;
+  j["update_mix"] = {{"on_route", c.on_route_fraction},
+                     {"near_route", c.near_route_fraction},
+                     {"elsewhere", 1.0 - c.on_route_fraction - c.near_route_fraction},
+                     {"clearing", c.clearing_fraction}};
   j["replans"] = r.replans;
   j["route_changes"] = r.route_changes;
   j["dstar"] = lat(r.dstar);
   j["dstar"]["mean_expanded"] = r.dstar_mean_expanded;
+  j["dstar"]["mean_rekeyed"] = r.dstar_mean_rekeyed;
+  j["dstar"]["mean_raised"] = r.dstar_mean_raised;
   j["astar"] = lat(r.astar);
   j["astar"]["mean_settled"] = r.astar_mean_settled;
   if (c.run_dijkstra) {

@@ -16,8 +16,13 @@ struct ReplanBenchConfig {
   std::uint64_t seed = 1;
   double drive_step_s = 10.0;      // driving time between two update batches
   double vmax_kmh = 120.0;
-  double on_route_fraction = 0.25;  // of each batch: edges ahead on the current route
-  double near_route_fraction = 0.25;  // edges touching the route's intersections
+  // Where each update lands: on the current route, on an edge touching one of its intersections,
+  // or anywhere. Routes use main roads, where congestion concentrates, hence more than a uniform
+  // share. Of the updates, `clearing_fraction` clear an already congested edge (cost decreases),
+  // 3 % close an edge, and the rest slow an edge down (factor 1-4, half with a queue of 0-60 s).
+  double on_route_fraction = 0.10;
+  double near_route_fraction = 0.20;
+  double clearing_fraction = 0.35;
   double min_trip_m = 0.0;         // straight-line; 0 = a third of the map's diagonal, at most 5 km
   bool run_dijkstra = true;
   std::uint32_t max_replans_per_trip = 1000;
@@ -44,6 +49,8 @@ struct ReplanBenchResult {
   LatencySummary dstar, astar, dijkstra;
   LatencySummary dstar_initial, astar_initial;
   double dstar_mean_expanded = 0;
+  double dstar_mean_rekeyed = 0;
+  double dstar_mean_raised = 0;
   double astar_mean_settled = 0;
   double dijkstra_mean_settled = 0;
 };

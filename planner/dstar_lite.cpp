@@ -86,6 +86,7 @@ ReplanStats DStarLite::replan() {
     const Key k_new = calculate_key(u);
     ++stats.expanded;
     if (k_old < k_new) {
+      ++stats.rekeyed;
       open_.push_or_update(u.v, k_new);
     } else if (g_[u.index()] > rhs_[u.index()]) {
       // Overconsistent: settle u and relax its predecessors.
@@ -103,6 +104,7 @@ ReplanStats DStarLite::replan() {
       });
     } else {
       // Underconsistent: u's old value may have supported its predecessors; re-derive them.
+      ++stats.underconsistent;
       const double g_old = g_[u.index()];
       g_[u.index()] = kInfCost;
       space_.for_each_predecessor(u, [&](Vertex s, double c) {

@@ -15,8 +15,10 @@
 namespace corridor::planner {
 
 struct ReplanStats {
-  std::uint64_t expanded = 0;  // vertices taken off the queue
-  std::uint64_t updated = 0;   // UpdateVertex calls
+  std::uint64_t expanded = 0;        // vertices taken off the queue
+  std::uint64_t rekeyed = 0;         // of those, put back with a fresher key
+  std::uint64_t underconsistent = 0;  // of those, raised to infinity (a cost increase propagating)
+  std::uint64_t updated = 0;         // rhs values changed
 };
 
 class DStarLite {
