@@ -1,0 +1,115 @@
+#include "maps/edge_snapper.hpp"
+
+#include <gtest/gtest.h>
+
+#include <limits>
+#include <random>
+
+#include "maps/errors.hpp"
+#include "maps/synthetic_grid.hpp"
+
+namespace corridor::maps {
+namespace {
+
+RoadGraph grid() {
+  GridSpec spec;
+  spec.rows = 12;
+  spec.cols = 12;
+  spec.seed = 11;
+  return make_perturbed_grid(spec);
+}
+
+// Brute force over every polyline segment: the oracle for the R-tree.
+double brute_force_distance(const RoadGraph& g, Point2 p) {
+  double best = std::numeric_limits<double>::infinity();
+  for (EdgeId e : g.edges()) {
+    const auto pts = g.geometry(e);
+    for (std::size_t i = 1; i < pts.size(); ++i) {
+      const double dx = pts[i].x_m - pts[i - 1].x_m, dy = pts[i].y_m - pts[i - 1].y_m;
+      const double len2 = dx * dx + dy * dy;
+      const double t = len2 > 0 ? std::clamp(((p.x_m - pts[i - 1].x_m) * dx + (p.y_m - pts[i - 1].y_m) * dy) / len2, 0.0, 1.0) : 0.0;
+      best = std::min(best, distance_m(p, {pts[i - 1].x_m + t * dx, pts[i - 1].y_m + t * dy}));
+    }
+  }
+  return best;
+}
+
+TEST(EdgeSnapper, NearestPointMatchesBruteForce) {
+  const RoadGraph g = grid();
+  const EdgeSnapper snapper(g);
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> x(g.min_corner().x_m, g.max_corner().x_m);
+  std::uniform_real_distribution<double> y(g.min_corner().y_m, g.max_corner().y_m);
+  for (int i = 0; i < 500; ++i) {
+    const Point2 p{x(rng), y(rng)};
+    const SnapResult r = snapper.snap_local(p, {1e6});
+    EXPECT_NEAR(r.distance_m, brute_force_distance(g, p), 1e-6);
+    // The reported offset lands on the reported point.
+    EXPECT_NEAR(distance_m(g.point_along(r.edge, r.offset_m), r.point), 0.0, 1e-6);
+    if (r.twin.valid()) {
+      EXPECT_NEAR(distance_m(g.point_along(r.twin, r.twin_offset_m), r.point), 0.0, 1e-6);
+    }
+  }
+}
+
+TEST(EdgeSnapper, LatLonOnARoadSnapsOntoIt) {
+  const RoadGraph g = grid();
+  const EdgeSnapper snapper(g);
+  const EdgeId e{7};
+  const Point2 mid = g.point_along(e, g.length_m(e) / 3);
+  const SnapResult r = snapper.snap(g.projection().to_lat_lon(mid));
+  EXPECT_LT(r.distance_m, 1e-3);
+  EXPECT_TRUE(r.edge == e || r.edge == g.twin(e));
+  const double expected = r.edge == e ? g.length_m(e) / 3 : g.length_m(e) * 2 / 3;
+  EXPECT_NEAR(r.offset_m, expected, 1e-3);
+}
+
+TEST(EdgeSnapper, FarFromAnyRoadIsAnError) {
+  const RoadGraph g = grid();
+  const EdgeSnapper snapper(g);
+  // Find a point inside the map that is more than 60 m from every road, then allow only 50 m.
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> x(g.min_corner().x_m, g.max_corner().x_m);
+  std::uniform_real_distribution<double> y(g.min_corner().y_m, g.max_corner().y_m);
+  Point2 p;
+  do {
+    p = {x(rng), y(rng)};
+  } while (brute_force_distance(g, p) < 60.0);
+  try {
+    (void)snapper.snap_local(p, {50.0});
+    FAIL() << "expected SnapError";
+  } catch (const SnapError& e) {
+    EXPECT_EQ(e.reason(), SnapError::Reason::too_far_from_road) << e.what();
+    EXPECT_NE(std::string(e.what()).find("within 50.0 m"), std::string::npos) << e.what();
+  }
+  EXPECT_NO_THROW((void)snapper.snap_local(p, {SnapOptions{}.max_distance_m}));
+}
+
+TEST(EdgeSnapper, OutsideTheMapIsAnError) {
+  const RoadGraph g = grid();
+  const EdgeSnapper snapper(g);
+  try {
+    (void)snapper.snap({0.0, 0.0});
+    FAIL();
+  } catch (const SnapError& e) {
+    EXPECT_EQ(e.reason(), SnapError::Reason::outside_map);
+    EXPECT_NE(std::string(e.what()).find("outside the map"), std::string::npos);
+  }
+}
+
+TEST(EdgeSnapper, InvalidCoordinatesAreErrors) {
+  const RoadGraph g = grid();
+  const EdgeSnapper snapper(g);
+  for (LatLon p : {LatLon{91, 9}, LatLon{47, 181}, LatLon{std::nan(""), 9},
+                   LatLon{47, std::numeric_limits<double>::infinity()}}) {
+    try {
+      (void)snapper.snap(p);
+      FAIL();
+    } catch (const SnapError& e) {
+      EXPECT_EQ(e.reason(), SnapError::Reason::invalid_coordinate);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace corridor::maps

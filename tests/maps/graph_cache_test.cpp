@@ -1,0 +1,137 @@
+#include "maps/graph_cache.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <thread>
+
+#include "maps/errors.hpp"
+#include "maps/map_loader.hpp"
+#include "maps/synthetic_grid.hpp"
+#include "tests/maps/osm_fixture.hpp"
+
+namespace corridor::maps {
+namespace {
+
+using testing::TempDir;
+
+RoadGraph small_grid() {
+  GridSpec spec;
+  spec.rows = 6;
+  spec.cols = 7;
+  spec.seed = 3;
+  return make_perturbed_grid(spec);
+}
+
+void expect_same_graph(const RoadGraph& a, const RoadGraph& b) {
+  ASSERT_EQ(a.node_count(), b.node_count());
+  ASSERT_EQ(a.edge_count(), b.edge_count());
+  EXPECT_EQ(a.data().first_out, b.data().first_out);
+  EXPECT_EQ(a.data().edge_head, b.data().edge_head);
+  EXPECT_EQ(a.data().edge_length_m, b.data().edge_length_m);
+  EXPECT_EQ(a.data().edge_twin, b.data().edge_twin);
+  EXPECT_EQ(a.data().node_signalized, b.data().node_signalized);
+  EXPECT_EQ(a.data().in_edge, b.data().in_edge);
+  EXPECT_EQ(a.data().geometry.size(), b.data().geometry.size());
+  EXPECT_DOUBLE_EQ(a.projection().origin().lat_deg, b.projection().origin().lat_deg);
+}
+
+TEST(GraphCache, RoundTripPreservesTheGraph) {
+  TempDir dir;
+  const RoadGraph g = small_grid();
+  const auto file = dir.path() / "g.cgr";
+  write_graph_cache(file, g, CacheSource{123, 456});
+  EXPECT_TRUE(looks_like_graph_cache(file));
+  CacheSource source;
+  const RoadGraph back = read_graph_cache(file, &source);
+  expect_same_graph(g, back);
+  EXPECT_EQ(source, (CacheSource{123, 456}));
+}
+
+TEST(GraphCache, CorruptByteIsDetected) {
+  TempDir dir;
+  const auto file = dir.path() / "g.cgr";
+  write_graph_cache(file, small_grid(), {});
+  {
+    std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(200);
+    f.put('\x5a');
+  }
+  EXPECT_THROW((void)read_graph_cache(file), GraphCacheError);
+}
+
+TEST(GraphCache, TruncatedFileIsDetected) {
+  TempDir dir;
+  const auto file = dir.path() / "g.cgr";
+  write_graph_cache(file, small_grid(), {});
+  std::filesystem::resize_file(file, std::filesystem::file_size(file) / 2);
+  EXPECT_THROW((void)read_graph_cache(file), GraphCacheError);
+}
+
+TEST(GraphCache, OtherVersionIsRejectedWithAHint) {
+  TempDir dir;
+  const auto file = dir.path() / "g.cgr";
+  write_graph_cache(file, small_grid(), {});
+  {
+    std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(8);
+    const std::uint32_t version = kGraphCacheVersion + 1;
+    f.write(reinterpret_cast<const char*>(&version), sizeof version);
+  }
+  try {
+    (void)read_graph_cache(file);
+    FAIL();
+  } catch (const GraphCacheError& e) {
+    EXPECT_NE(std::string(e.what()).find("re-import"), std::string::npos) << e.what();
+  }
+}
+
+TEST(GraphCache, NotACacheIsRejected) {
+  TempDir dir;
+  const auto file = dir.path() / "x.cgr";
+  std::ofstream(file) << "<?xml version='1.0'?><osm></osm>";
+  EXPECT_FALSE(looks_like_graph_cache(file));
+  EXPECT_THROW((void)read_graph_cache(file), GraphCacheError);
+}
+
+TEST(MapLoader, ImportsOnceThenReusesTheCacheUntilTheSourceChanges) {
+  TempDir dir;
+  const auto osm = dir.path() / "town.osm";
+  testing::write_osm(osm, {{1, 47.0, 9.5, {}}, {2, 47.001, 9.5, {}}},
+                     {{1, {1, 2}, {{"highway", "residential"}}}});
+  MapLoadOptions options;
+  options.cache_dir = dir.path() / "cache";
+  options.import.show_progress = false;
+  MapLoadInfo info;
+  const RoadGraph first = load_map(osm, options, &info);
+  EXPECT_EQ(info.origin, MapLoadInfo::Origin::imported);
+  ASSERT_TRUE(std::filesystem::exists(info.cache_file));
+  const RoadGraph second = load_map(osm, options, &info);
+  EXPECT_EQ(info.origin, MapLoadInfo::Origin::cache);
+  expect_same_graph(first, second);
+
+  // A changed source invalidates the cache.
+  testing::write_osm(osm, {{1, 47.0, 9.5, {}}, {2, 47.001, 9.5, {}}, {3, 47.001, 9.501, {}}},
+                     {{1, {1, 2}, {{"highway", "residential"}}}, {2, {2, 3}, {{"highway", "residential"}}},
+                      {3, {3, 1}, {{"highway", "residential"}}}});
+  const RoadGraph third = load_map(osm, options, &info);
+  EXPECT_EQ(info.origin, MapLoadInfo::Origin::imported);
+  EXPECT_EQ(third.node_count(), 3u);
+
+  // A corrupt cache is replaced by a fresh import, not an error.
+  std::filesystem::resize_file(info.cache_file, 20);
+  (void)load_map(osm, options, &info);
+  EXPECT_EQ(info.origin, MapLoadInfo::Origin::imported);
+
+  // A cache file given directly as the map is read as such.
+  const RoadGraph direct = load_map(info.cache_file, options, &info);
+  EXPECT_EQ(info.origin, MapLoadInfo::Origin::cache);
+  EXPECT_EQ(direct.node_count(), 3u);
+}
+
+TEST(MapLoader, MissingMapIsAClearError) {
+  EXPECT_THROW((void)load_map("/no/such/map.osm.pbf", {}), MapLoadError);
+}
+
+}  // namespace
+}  // namespace corridor::maps

@@ -1,0 +1,90 @@
+// Writes small OSM XML files for importer tests: nodes on a local grid, ways with tags.
+#pragma once
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+namespace corridor::maps::testing {
+
+struct FixtureNode {
+  long long id;
+  double lat;
+  double lon;
+  std::map<std::string, std::string> tags;
+};
+
+struct FixtureWay {
+  long long id;
+  std::vector<long long> nodes;
+  std::map<std::string, std::string> tags;
+};
+
+inline std::string xml_escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    if (c == '"') out += "&quot;";
+    else if (c == '&') out += "&amp;";
+    else if (c == '<') out += "&lt;";
+    else out += c;
+  }
+  return out;
+}
+
+inline void write_osm(const std::filesystem::path& file, const std::vector<FixtureNode>& nodes,
+                      const std::vector<FixtureWay>& ways) {
+  std::ofstream out(file);
+  out << "<?xml version='1.0' encoding='UTF-8'?>\n<osm version=\"0.6\" generator=\"corridor-tests\">\n";
+  out.precision(10);
+  for (const auto& n : nodes) {
+    out << "  <node id=\"" << n.id << "\" version=\"1\" lat=\"" << n.lat << "\" lon=\"" << n.lon << "\"";
+    if (n.tags.empty()) {
+      out << "/>\n";
+      continue;
+    }
+    out << ">\n";
+    for (const auto& [k, v] : n.tags) out << "    <tag k=\"" << xml_escape(k) << "\" v=\"" << xml_escape(v) << "\"/>\n";
+    out << "  </node>\n";
+  }
+  for (const auto& w : ways) {
+    out << "  <way id=\"" << w.id << "\" version=\"1\">\n";
+    for (long long ref : w.nodes) out << "    <nd ref=\"" << ref << "\"/>\n";
+    for (const auto& [k, v] : w.tags) out << "    <tag k=\"" << xml_escape(k) << "\" v=\"" << xml_escape(v) << "\"/>\n";
+    out << "  </way>\n";
+  }
+  out << "</osm>\n";
+}
+
+// A fresh temporary directory per test, removed afterwards.
+class TempDir {
+ public:
+  TempDir() {
+    path_ = std::filesystem::temp_directory_path() /
+            ("corridor-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter()++));
+    std::filesystem::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  [[nodiscard]] const std::filesystem::path& path() const { return path_; }
+
+ private:
+  static int& counter() {
+    static int c = 0;
+    return c;
+  }
+  std::filesystem::path path_;
+};
+
+inline std::filesystem::path shared_osm(const std::string& name) {
+  return std::filesystem::path(CORRIDOR_SHARED_DATA_DIR) / "osm" / name;
+}
+
+}  // namespace corridor::maps::testing

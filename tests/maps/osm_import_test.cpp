@@ -1,0 +1,268 @@
+#include "maps/osm_import.hpp"
+
+#include <gtest/gtest.h>
+#include <zlib.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "maps/errors.hpp"
+#include "maps/osm_tags.hpp"
+#include "tests/maps/osm_fixture.hpp"
+
+namespace corridor::maps {
+namespace {
+
+using testing::FixtureNode;
+using testing::FixtureWay;
+using testing::TempDir;
+using testing::write_osm;
+
+// A node `x_m` east and `y_m` north of (47.0, 9.5).
+FixtureNode at(long long id, double x_m, double y_m, std::map<std::string, std::string> tags = {}) {
+  constexpr double kMetersPerDegLat = 111195.0;
+  const double lon_scale = kMetersPerDegLat * std::cos(47.0 * M_PI / 180.0);
+  return {id, 47.0 + y_m / kMetersPerDegLat, 9.5 + x_m / lon_scale, std::move(tags)};
+}
+
+NodeId node_by_osm(const RoadGraph& g, long long osm) {
+  for (NodeId v : g.nodes()) {
+    if (g.osm_node(v).v == osm) return v;
+  }
+  return kInvalidNode;
+}
+
+EdgeId edge_between(const RoadGraph& g, long long from, long long to) {
+  const NodeId a = node_by_osm(g, from);
+  const NodeId b = node_by_osm(g, to);
+  if (!a.valid() || !b.valid()) return kInvalidEdge;
+  for (EdgeId e : g.out_edges(a)) {
+    if (g.head(e) == b) return e;
+  }
+  return kInvalidEdge;
+}
+
+RoadGraph import_fixture(const std::vector<FixtureNode>& nodes, const std::vector<FixtureWay>& ways,
+                         OsmImportReport* report = nullptr) {
+  TempDir dir;
+  const auto file = dir.path() / "fixture.osm";
+  write_osm(file, nodes, ways);
+  OsmImportOptions options;
+  options.show_progress = false;
+  return import_osm(file, options, report);
+}
+
+const std::map<std::string, std::string> kResidential{{"highway", "residential"}};
+
+TEST(OsmImport, DegreeTwoChainsBecomeOneEdgeWithGeometry) {
+  // Way 1: 1-2-3-4-5 along the x axis; way 2 leaves node 3 northward, so 3 is a junction.
+  const auto g = import_fixture({at(1, 0, 0), at(2, 50, 0), at(3, 100, 0), at(4, 150, 0), at(5, 200, 0), at(6, 100, 80)},
+                                {{10, {1, 2, 3, 4, 5}, kResidential}, {11, {3, 6}, kResidential}});
+  EXPECT_EQ(g.node_count(), 4u);  // 1, 3, 5, 6: nodes 2 and 4 are geometry only
+  EXPECT_EQ(g.edge_count(), 6u);
+  const EdgeId e = edge_between(g, 1, 3);
+  ASSERT_TRUE(e.valid());
+  EXPECT_EQ(g.geometry(e).size(), 3u);
+  EXPECT_NEAR(g.length_m(e), 100.0, 0.5);
+  EXPECT_EQ(g.osm_way(e).v, 10);
+  EXPECT_TRUE(g.twin(e).valid());
+  EXPECT_EQ(g.head(g.twin(e)), g.tail(e));
+  EXPECT_FALSE(node_by_osm(g, 2).valid());
+}
+
+TEST(OsmImport, OnewayWaysGetOneDirectedEdge) {
+  // A one-way triangle 1->2->3->1, and a two-way street 1-4 so the triangle has an exit.
+  const std::map<std::string, std::string> oneway{{"highway", "residential"}, {"oneway", "yes"}};
+  const std::map<std::string, std::string> reverse{{"highway", "residential"}, {"oneway", "-1"}};
+  const auto g = import_fixture({at(1, 0, 0), at(2, 100, 0), at(3, 50, 90), at(4, -100, 0)},
+                                {{20, {1, 2}, oneway}, {21, {2, 3}, oneway}, {22, {1, 3}, reverse}, {23, {1, 4}, kResidential}});
+  EXPECT_TRUE(edge_between(g, 1, 2).valid());
+  EXPECT_FALSE(edge_between(g, 2, 1).valid());
+  EXPECT_TRUE(edge_between(g, 2, 3).valid());
+  EXPECT_FALSE(edge_between(g, 3, 2).valid());
+  EXPECT_TRUE(edge_between(g, 3, 1).valid());  // oneway=-1 against the way's node order
+  EXPECT_FALSE(edge_between(g, 1, 3).valid());
+  EXPECT_FALSE(g.twin(edge_between(g, 1, 2)).valid());
+  EXPECT_TRUE(edge_between(g, 1, 4).valid() && edge_between(g, 4, 1).valid());
+}
+
+TEST(OsmImport, RoundaboutIsOnewayInWayOrder) {
+  const std::map<std::string, std::string> ring{{"highway", "primary"}, {"junction", "roundabout"}};
+  const auto g = import_fixture({at(1, 0, 0), at(2, 30, 30), at(3, 0, 60), at(4, -30, 30), at(5, 0, -100), at(6, 0, 160)},
+                                {{30, {1, 2, 3, 4, 1}, ring}, {31, {5, 1}, kResidential}, {32, {3, 6}, kResidential}});
+  const EdgeId forward = edge_between(g, 1, 3);
+  ASSERT_TRUE(forward.valid());
+  EXPECT_EQ(g.geometry(forward).size(), 3u);  // 1 -> 2 -> 3
+  EXPECT_TRUE(edge_between(g, 3, 1).valid());  // onward via 4
+  EXPECT_EQ(g.geometry(edge_between(g, 3, 1)).size(), 3u);
+  EXPECT_FALSE(g.twin(forward).valid());
+  for (EdgeId e : g.edges()) {
+    if (g.osm_way(e).v == 30) {
+      EXPECT_FALSE(g.twin(e).valid());
+    }
+  }
+}
+
+TEST(OsmImport, MaxspeedBecomesEdgeSpeed) {
+  const auto g = import_fixture({at(1, 0, 0), at(2, 100, 0), at(3, 200, 0)},
+                                {{40, {1, 2}, {{"highway", "secondary"}, {"maxspeed", "30 mph"}}},
+                                 {41, {2, 3}, {{"highway", "secondary"}}}});
+  EXPECT_NEAR(g.speed_mps(edge_between(g, 1, 2)), 30 * 1.609344 / 3.6, 1e-5);
+  EXPECT_NEAR(g.speed_mps(edge_between(g, 2, 3)), default_speed_kmh(RoadClass::secondary) / 3.6, 1e-5);
+  EXPECT_EQ(g.road_class(edge_between(g, 2, 3)), RoadClass::secondary);
+}
+
+TEST(OsmImport, AccessNoAndFootwaysAreExcluded) {
+  const auto g = import_fixture(
+      {at(1, 0, 0), at(2, 100, 0), at(3, 200, 0), at(4, 100, 100), at(5, 0, 100)},
+      {{50, {1, 2, 3}, kResidential},
+       {51, {2, 4}, {{"highway", "residential"}, {"access", "no"}}},
+       {52, {1, 5}, {{"highway", "footway"}}},
+       {53, {3, 5}, {{"highway", "footway"}, {"emergency", "yes"}}}});
+  EXPECT_FALSE(node_by_osm(g, 4).valid());
+  EXPECT_TRUE(edge_between(g, 3, 5).valid());  // emergency access road
+  EXPECT_FALSE(edge_between(g, 1, 5).valid());
+}
+
+TEST(OsmImport, KeepsLargestStronglyConnectedComponentAndReportsDropped) {
+  // A one-way spur 3 -> 7 is a trap: it leaves and never returns, so node 7 is dropped.
+  OsmImportReport report;
+  const auto g = import_fixture({at(1, 0, 0), at(2, 100, 0), at(3, 200, 0), at(4, 0, 100), at(7, 300, 0), at(8, 5000, 5000),
+                                 at(9, 5100, 5000)},
+                                {{60, {1, 2, 3}, kResidential},
+                                 {63, {1, 4}, kResidential},
+                                 {61, {3, 7}, {{"highway", "residential"}, {"oneway", "yes"}}},
+                                 {62, {8, 9}, kResidential}},
+                                &report);
+  EXPECT_EQ(g.node_count(), 3u);  // 1, 3 and 4
+  EXPECT_FALSE(node_by_osm(g, 7).valid());
+  EXPECT_EQ(report.graph.dropped_nodes, 3u);  // 7, 8, 9
+  EXPECT_EQ(report.graph.input_nodes, 6u);
+}
+
+TEST(OsmImport, SignalsAtAndNearJunctionsMarkTheJunction) {
+  const std::map<std::string, std::string> signal{{"highway", "traffic_signals"}};
+  // Junction 3 has a signal 20 m before it on way 70; junction 5 carries the tag itself; the signal
+  // at node 11 is 150 m from any junction and marks nothing.
+  const auto g = import_fixture(
+      {at(1, 0, 0), at(2, 180, 0, signal), at(3, 200, 0), at(4, 200, 100), at(5, 400, 0, signal), at(6, 400, 100),
+       at(10, 0, 300), at(11, 150, 300, signal), at(12, 300, 300)},
+      {{70, {1, 2, 3, 5}, kResidential},
+       {71, {3, 4}, kResidential},
+       {72, {5, 6}, kResidential},
+       {73, {1, 10}, kResidential},
+       {74, {10, 11, 12, 6}, kResidential}});
+  EXPECT_TRUE(g.signalized(node_by_osm(g, 3)));
+  EXPECT_TRUE(g.signalized(node_by_osm(g, 5)));
+  EXPECT_FALSE(g.signalized(node_by_osm(g, 1)));
+  EXPECT_FALSE(g.signalized(node_by_osm(g, 10)));
+  EXPECT_FALSE(g.signalized(node_by_osm(g, 6)));
+}
+
+TEST(OsmImport, WaysCutByTheExtractBorderAreSplit) {
+  // Node 99 is not in the file (outside the extract); the way continues on both sides of it.
+  const auto g = import_fixture({at(1, 0, 0), at(2, 100, 0), at(3, 200, 0), at(4, 300, 0), at(5, 100, 100), at(6, 200, 100)},
+                                {{80, {1, 2, 99, 3, 4}, kResidential}, {81, {2, 5, 6, 3}, kResidential}});
+  EXPECT_TRUE(edge_between(g, 1, 2).valid());
+  EXPECT_TRUE(edge_between(g, 3, 4).valid());
+  // 2 and 3 are joined only by way 81, around the missing node, never straight across the gap.
+  const EdgeId e = edge_between(g, 2, 3);
+  ASSERT_TRUE(e.valid());
+  EXPECT_EQ(g.osm_way(e).v, 81);
+  EXPECT_NEAR(g.length_m(e), 300.0, 1.0);
+}
+
+TEST(OsmImport, ReadsGzipCompressedXml) {
+  TempDir dir;
+  const auto plain = dir.path() / "a.osm";
+  write_osm(plain, {at(1, 0, 0), at(2, 100, 0)}, {{90, {1, 2}, kResidential}});
+  std::ifstream in(plain, std::ios::binary);
+  const std::string xml((std::istreambuf_iterator<char>(in)), {});
+  const auto gz = dir.path() / "a.osm.gz";
+  gzFile out = gzopen(gz.c_str(), "wb");
+  ASSERT_NE(out, nullptr);
+  ASSERT_EQ(gzwrite(out, xml.data(), static_cast<unsigned>(xml.size())), static_cast<int>(xml.size()));
+  gzclose(out);
+  OsmImportOptions options;
+  options.show_progress = false;
+  const auto g = import_osm(gz, options);
+  EXPECT_EQ(g.node_count(), 2u);
+  EXPECT_EQ(g.edge_count(), 2u);
+}
+
+TEST(OsmImport, MissingFileIsAClearError) {
+  try {
+    (void)import_osm("/nonexistent/dir/city.osm.pbf");
+    FAIL() << "expected MapLoadError";
+  } catch (const MapLoadError& e) {
+    EXPECT_NE(std::string(e.what()).find("not found"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/dir/city.osm.pbf"), std::string::npos) << e.what();
+  }
+}
+
+TEST(OsmImport, CorruptPbfIsAClearError) {
+  TempDir dir;
+  const auto file = dir.path() / "broken.osm.pbf";
+  std::ofstream(file, std::ios::binary) << std::string("\x00\x00\x00\x0dthis is not a protobuf blob at all", 40);
+  try {
+    OsmImportOptions options;
+    options.show_progress = false;
+    (void)import_osm(file, options);
+    FAIL() << "expected MapLoadError";
+  } catch (const MapLoadError& e) {
+    EXPECT_NE(std::string(e.what()).find("broken.osm.pbf"), std::string::npos) << e.what();
+  }
+}
+
+TEST(OsmImport, FileWithoutRoadsIsAClearError) {
+  EXPECT_THROW((void)import_fixture({at(1, 0, 0), at(2, 100, 0)}, {{1, {1, 2}, {{"highway", "footway"}}}}),
+               MapLoadError);
+}
+
+TEST(OsmImport, UnknownExtensionIsAClearError) {
+  TempDir dir;
+  const auto file = dir.path() / "map.txt";
+  std::ofstream(file) << "hello";
+  EXPECT_THROW((void)import_osm(file), MapLoadError);
+}
+
+struct ExtractCase {
+  const char* file;
+  std::size_t min_nodes;
+};
+
+class SharedExtract : public ::testing::TestWithParam<ExtractCase> {};
+
+TEST_P(SharedExtract, ImportsIntoAConsistentGraph) {
+  const auto file = testing::shared_osm(GetParam().file);
+  if (!std::filesystem::exists(file)) GTEST_SKIP() << "shared data not present: " << file;
+  OsmImportReport report;
+  OsmImportOptions options;
+  options.show_progress = false;
+  const RoadGraph g = import_osm(file, options, &report);
+  EXPECT_GE(g.node_count(), GetParam().min_nodes);
+  EXPECT_GT(g.edge_count(), g.node_count());
+  EXPECT_EQ(report.graph.kept_nodes + report.graph.dropped_nodes, report.graph.input_nodes);
+  EXPECT_GT(report.osm_ways_kept, 0u);
+  for (EdgeId e : g.edges()) {
+    ASSERT_GT(g.length_m(e), 0.0);
+    ASSERT_GT(g.speed_mps(e), 0.0);
+    const auto pts = g.geometry(e);
+    // The polyline runs from the tail node to the head node.
+    ASSERT_NEAR(distance_m(pts.front(), g.position(g.tail(e))), 0.0, 1e-6);
+    ASSERT_NEAR(distance_m(pts.back(), g.position(g.head(e))), 0.0, 1e-6);
+    if (g.twin(e).valid()) {
+      ASSERT_EQ(g.twin(g.twin(e)), e);
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(AllExtracts, SharedExtract,
+                         // The Berlin clip cuts the one-way carriageways at its border: only the Großer
+                         // Stern roundabout itself is strongly connected.
+                         ::testing::Values(ExtractCase{"monaco.osm.gz", 500}, ExtractCase{"andorra.osm.pbf", 1000},
+                                           ExtractCase{"liechtenstein.osm.pbf", 3000},
+                                           ExtractCase{"berlin-siegessaeule.osm.gz", 10}));
+
+}  // namespace
+}  // namespace corridor::maps

@@ -1,0 +1,168 @@
+#include "maps/osm_tags.hpp"
+
+#include <gtest/gtest.h>
+
+namespace corridor::maps {
+namespace {
+
+TEST(MaxspeedParsing, PlainNumbersAreKmh) {
+  EXPECT_DOUBLE_EQ(*parse_maxspeed_kmh("50"), 50.0);
+  EXPECT_DOUBLE_EQ(*parse_maxspeed_kmh(" 80 "), 80.0);
+  EXPECT_DOUBLE_EQ(*parse_maxspeed_kmh("30 km/h"), 30.0);
+  EXPECT_DOUBLE_EQ(*parse_maxspeed_kmh("7.5"), 7.5);
+}
+
+TEST(MaxspeedParsing, MphAndKnotsAreConverted) {
+  EXPECT_NEAR(*parse_maxspeed_kmh("30 mph"), 48.28032, 1e-9);
+  EXPECT_NEAR(*parse_maxspeed_kmh("20mph"), 32.18688, 1e-9);
+  EXPECT_NEAR(*parse_maxspeed_kmh("10 knots"), 18.52, 1e-9);
+}
+
+TEST(MaxspeedParsing, SpecialWords) {
+  EXPECT_DOUBLE_EQ(*parse_maxspeed_kmh("none"), 140.0);
+  EXPECT_DOUBLE_EQ(*parse_maxspeed_kmh("walk"), 6.0);
+  EXPECT_FALSE(parse_maxspeed_kmh("signals").has_value());
+  EXPECT_FALSE(parse_maxspeed_kmh("variable").has_value());
+  EXPECT_FALSE(parse_maxspeed_kmh("").has_value());
+  EXPECT_FALSE(parse_maxspeed_kmh("fast").has_value());
+  EXPECT_FALSE(parse_maxspeed_kmh("-20").has_value());
+  EXPECT_FALSE(parse_maxspeed_kmh("50 furlongs").has_value());
+}
+
+TEST(MaxspeedParsing, ImplicitCountryValues) {
+  EXPECT_DOUBLE_EQ(*parse_maxspeed_kmh("DE:urban"), 50.0);
+  EXPECT_DOUBLE_EQ(*parse_maxspeed_kmh("DE:rural"), 100.0);
+  EXPECT_DOUBLE_EQ(*parse_maxspeed_kmh("FR:rural"), 80.0);
+  EXPECT_DOUBLE_EQ(*parse_maxspeed_kmh("CH:motorway"), 120.0);
+  EXPECT_DOUBLE_EQ(*parse_maxspeed_kmh("RU:urban"), 60.0);
+  EXPECT_DOUBLE_EQ(*parse_maxspeed_kmh("XX:urban"), 50.0);  // unknown country: generic value
+  EXPECT_NEAR(*parse_maxspeed_kmh("GB:nsl_single"), 96.56064, 1e-9);
+  EXPECT_DOUBLE_EQ(*parse_maxspeed_kmh("DE:zone30"), 30.0);
+  EXPECT_DOUBLE_EQ(*parse_maxspeed_kmh("DE:zone:20"), 20.0);
+  EXPECT_DOUBLE_EQ(*parse_maxspeed_kmh("DE:living_street"), 7.0);
+  EXPECT_FALSE(parse_maxspeed_kmh("DE:nonsense").has_value());
+}
+
+TEST(MaxspeedParsing, FirstOfSeveralValues) { EXPECT_DOUBLE_EQ(*parse_maxspeed_kmh("50;30"), 50.0); }
+
+WayTags road(std::string_view highway) {
+  WayTags t;
+  t.highway = highway;
+  return t;
+}
+
+TEST(WayRules, DrivableClassesAreKeptOthersDropped) {
+  for (auto h : {"motorway", "trunk", "primary", "secondary", "tertiary", "unclassified", "residential",
+                 "living_street", "service", "motorway_link", "trunk_link", "primary_link", "secondary_link",
+                 "tertiary_link"}) {
+    EXPECT_TRUE(interpret_way(road(h)).has_value()) << h;
+  }
+  for (auto h : {"footway", "cycleway", "path", "steps", "track", "pedestrian", "bridleway", "construction", ""}) {
+    EXPECT_FALSE(interpret_way(road(h)).has_value()) << h;
+  }
+}
+
+TEST(WayRules, EmergencyYesOpensAnyHighway) {
+  WayTags t = road("pedestrian");
+  t.emergency = "yes";
+  const auto rules = interpret_way(t);
+  ASSERT_TRUE(rules.has_value());
+  EXPECT_EQ(rules->road_class, RoadClass::emergency_access);
+  EXPECT_TRUE(rules->forward && rules->backward);
+}
+
+TEST(WayRules, EmergencyNoClosesADrivableRoad) {
+  WayTags t = road("residential");
+  t.emergency = "no";
+  EXPECT_FALSE(interpret_way(t).has_value());
+}
+
+TEST(WayRules, AccessRules) {
+  WayTags t = road("residential");
+  t.access = "no";
+  EXPECT_FALSE(interpret_way(t).has_value());
+  t.access = "private";  // private and destination do not stop an emergency vehicle
+  EXPECT_TRUE(interpret_way(t).has_value());
+  t.access = "destination";
+  EXPECT_TRUE(interpret_way(t).has_value());
+  t.access = "yes";
+  t.motor_vehicle = "no";
+  EXPECT_FALSE(interpret_way(t).has_value());
+  t.motorcar = "yes";  // the most specific tag wins
+  EXPECT_TRUE(interpret_way(t).has_value());
+  WayTags closed = road("service");
+  closed.access = "no";
+  closed.emergency = "yes";  // explicitly open to emergency vehicles
+  EXPECT_TRUE(interpret_way(closed).has_value());
+  WayTags agri = road("service");
+  agri.vehicle = "agricultural";
+  EXPECT_FALSE(interpret_way(agri).has_value());
+}
+
+TEST(WayRules, Oneway) {
+  WayTags t = road("residential");
+  auto r = interpret_way(t);
+  EXPECT_TRUE(r->forward && r->backward);
+  for (auto v : {"yes", "true", "1"}) {
+    t.oneway = v;
+    r = interpret_way(t);
+    EXPECT_TRUE(r->forward && !r->backward) << v;
+  }
+  for (auto v : {"-1", "reverse"}) {
+    t.oneway = v;
+    r = interpret_way(t);
+    EXPECT_TRUE(!r->forward && r->backward) << v;
+  }
+  t.oneway = "no";
+  r = interpret_way(t);
+  EXPECT_TRUE(r->forward && r->backward);
+  t.oneway = "reversible";
+  EXPECT_FALSE(interpret_way(t).has_value());
+  t.oneway = "yes";
+  t.oneway_emergency = "no";
+  r = interpret_way(t);
+  EXPECT_TRUE(r->forward && r->backward);
+}
+
+TEST(WayRules, RoundaboutAndMotorwayImplyOneway) {
+  WayTags t = road("primary");
+  t.junction = "roundabout";
+  auto r = interpret_way(t);
+  EXPECT_TRUE(r->forward && !r->backward);
+  t.junction = "circular";
+  r = interpret_way(t);
+  EXPECT_TRUE(r->forward && !r->backward);
+  t.oneway = "no";  // an explicit tag overrides the implication
+  r = interpret_way(t);
+  EXPECT_TRUE(r->forward && r->backward);
+  r = interpret_way(road("motorway"));
+  EXPECT_TRUE(r->forward && !r->backward);
+  r = interpret_way(road("motorway_link"));
+  EXPECT_TRUE(r->forward && r->backward);
+}
+
+TEST(WayRules, SpeedFromMaxspeedOrClassDefault) {
+  WayTags t = road("residential");
+  auto r = interpret_way(t);
+  EXPECT_DOUBLE_EQ(r->forward_speed_kmh, default_speed_kmh(RoadClass::residential));
+  t.maxspeed = "DE:urban";
+  r = interpret_way(t);
+  EXPECT_DOUBLE_EQ(r->forward_speed_kmh, 50.0);
+  t.maxspeed = "signals";  // no number: class default
+  r = interpret_way(t);
+  EXPECT_DOUBLE_EQ(r->forward_speed_kmh, default_speed_kmh(RoadClass::residential));
+  t.maxspeed = "60";
+  t.maxspeed_backward = "40";
+  r = interpret_way(t);
+  EXPECT_DOUBLE_EQ(r->forward_speed_kmh, 60.0);
+  EXPECT_DOUBLE_EQ(r->backward_speed_kmh, 40.0);
+}
+
+TEST(WayRules, AreasAreNotRoads) {
+  WayTags t = road("service");
+  t.area = "yes";
+  EXPECT_FALSE(interpret_way(t).has_value());
+}
+
+}  // namespace
+}  // namespace corridor::maps
