@@ -5,7 +5,9 @@
 #include <random>
 
 #include "planner/one_to_one_search.hpp"
+#include "maps/osm_import.hpp"
 #include "tests/planner/test_graphs.hpp"
+#include "tests/planner/test_graphs_line.hpp"
 
 namespace corridor::planner {
 namespace {
@@ -120,6 +122,142 @@ TEST(DStarLite, ReplanMatchesDijkstraAfterRandomUpdateSequences) {
   }
   EXPECT_EQ(replans, kSequences * 25);
 }
+
+TEST(DStarLite, ReplanMatchesDijkstraAfterCongestionUpdate) {
+  const auto g = testing::diamond();
+  CostOverlay overlay(g);
+  const TravelCost cost(g, overlay, {30.0});
+  const EdgeId ab = testing::edge_from_to(g, 1, 2), ad = testing::edge_from_to(g, 1, 4);
+  const EdgeId bc = testing::edge_from_to(g, 2, 3), dc = testing::edge_from_to(g, 4, 3);
+  const std::vector<EdgePoint> starts{{ab, 0.0}, {ad, 0.0}};
+  const std::vector<EdgePoint> goals{{bc, 100.0}, {dc, g.length_m(dc)}};
+  DStarLite dstar(cost, starts, goals);
+  dstar.replan();
+  EXPECT_EQ(dstar.route().edges, (std::vector<EdgeId>{ad, dc}));
+  // A queue on D->C makes the straight road faster: the plan switches.
+  overlay.set_edge(dc, {1.0, 30.0});
+  const std::vector<EdgeId> changed{dc};
+  dstar.edges_changed(changed);
+  dstar.replan();
+  EXPECT_EQ(dstar.route().edges, (std::vector<EdgeId>{ab, bc}));
+  EXPECT_DOUBLE_EQ(dstar.cost_to_goal_s(), 20.0);
+  expect_matches_dijkstra(dstar, cost, starts, goals, "after increase");
+  // The queue clears: back to the detour (a cost decrease).
+  overlay.reset_edge(dc);
+  dstar.edges_changed(changed);
+  dstar.replan();
+  EXPECT_EQ(dstar.route().edges, (std::vector<EdgeId>{ad, dc}));
+  expect_matches_dijkstra(dstar, cost, starts, goals, "after decrease");
+}
+
+TEST(DStarLite, NodeDelayChangeRaisesTheCostThroughTheNode) {
+  const auto g = testing::diamond();
+  CostOverlay overlay(g);
+  const TravelCost cost(g, overlay, {30.0});
+  const EdgeId ab = testing::edge_from_to(g, 1, 2), bc = testing::edge_from_to(g, 2, 3);
+  // Start at B heading for C: straight on is 10 s. A 100 s signal delay at B is unavoidable, since
+  // every way out of B crosses B; the plan keeps the straight road and its cost rises by 100 s.
+  const std::vector<EdgePoint> starts{{ab, 100.0}};
+  const std::vector<EdgePoint> goals{{bc, 100.0}};
+  DStarLite dstar(cost, starts, goals);
+  dstar.replan();
+  EXPECT_DOUBLE_EQ(dstar.cost_to_goal_s(), 10.0);
+  const NodeId b = g.head(ab);
+  overlay.set_node_delay(b, 100.0);
+  const std::vector<NodeId> changed{b};
+  dstar.nodes_changed(changed);
+  dstar.replan();
+  EXPECT_DOUBLE_EQ(dstar.cost_to_goal_s(), 110.0);
+  expect_matches_dijkstra(dstar, cost, starts, goals, "after node delay");
+}
+
+TEST(DStarLite, MovingAlongTheRouteKeepsTheRestOfIt) {
+  const auto g = random_grid(77, 15, 15);
+  CostOverlay overlay(g);
+  const TravelCost cost(g, overlay, {30.0});
+  std::mt19937_64 rng(77);
+  const std::vector<EdgePoint> goals{random_point(g, rng)};
+  DStarLite dstar(cost, {random_point(g, rng)}, goals);
+  dstar.replan();
+  Route r = dstar.route();
+  ASSERT_TRUE(r.found);
+  while (r.edges.size() > 2) {
+    const EdgeId next = r.edges[1];
+    const std::vector<EdgeId> rest(r.edges.begin() + 1, r.edges.end());
+    dstar.move_start({{next, 0.0}});
+    dstar.replan();
+    r = dstar.route();
+    EXPECT_EQ(r.edges, rest);
+  }
+}
+
+TEST(DStarLite, UnreachableGoalAndRecovery) {
+  const auto g = testing::diamond();
+  CostOverlay overlay(g);
+  const TravelCost cost(g, overlay, {30.0});
+  const EdgeId ba = testing::edge_from_to(g, 2, 1), bc = testing::edge_from_to(g, 2, 3);
+  const std::vector<EdgeId> closed{testing::edge_from_to(g, 1, 2), testing::edge_from_to(g, 1, 4)};
+  for (EdgeId e : closed) overlay.close_edge(e);
+  DStarLite dstar(cost, {{ba, 0.0}}, {{bc, 50.0}});
+  dstar.replan();
+  EXPECT_EQ(dstar.cost_to_goal_s(), kInfCost);
+  EXPECT_FALSE(dstar.route().found);
+  overlay.reset_edge(closed[1]);
+  dstar.edges_changed(closed);
+  dstar.replan();
+  EXPECT_TRUE(dstar.route().found);
+  expect_matches_dijkstra(dstar, cost, {{ba, 0.0}}, {{bc, 50.0}}, "reopened");
+}
+
+// The same randomized oracle on real maps: trips with congestion on and off the route, start moves
+// along the route, and checks after every replan.
+class DStarLiteOnExtract : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(DStarLiteOnExtract, ReplanMatchesDijkstraWhileDriving) {
+  const auto file = std::filesystem::path(CORRIDOR_SHARED_DATA_DIR) / "osm" / GetParam();
+  if (!std::filesystem::exists(file)) GTEST_SKIP() << "shared data not present: " << file;
+  maps::OsmImportOptions options;
+  options.show_progress = false;
+  const maps::RoadGraph g = maps::import_osm(file, options);
+  std::mt19937_64 rng(2024);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int replans = 0;
+  for (int trip = 0; trip < 25; ++trip) {
+    CostOverlay overlay(g);
+    overlay.set_signal_delay(g, 20.0);
+    const TravelCost cost(g, overlay, {120.0 / 3.6});
+    const std::vector<EdgePoint> goals = with_twin(g, random_point(g, rng));
+    std::vector<EdgePoint> starts = with_twin(g, random_point(g, rng));
+    DStarLite dstar(cost, starts, goals);
+    dstar.replan();
+    for (int step = 0; step < 20; ++step) {
+      Route r = dstar.route();
+      if (!r.found || r.edges.size() < 3) break;
+      std::vector<EdgeId> changed;
+      for (int k = 0; k < 10; ++k) {
+        const EdgeId e = unit(rng) < 0.4 ? r.edges[std::uniform_int_distribution<std::size_t>(1, r.edges.size() - 1)(rng)]
+                                         : random_point(g, rng).edge;
+        if (unit(rng) < 0.3) {
+          overlay.reset_edge(e);
+        } else {
+          overlay.set_edge(e, {1.0 + 4.0 * unit(rng), 30.0 * unit(rng)});
+        }
+        changed.push_back(e);
+      }
+      starts = {{r.edges[1], g.length_m(r.edges[1]) * unit(rng)}};
+      dstar.move_start(starts);
+      dstar.edges_changed(changed);
+      dstar.replan();
+      expect_matches_dijkstra(dstar, cost, starts, goals, std::string(GetParam()) + " trip " + std::to_string(trip));
+      ++replans;
+      if (::testing::Test::HasFailure()) return;
+    }
+  }
+  EXPECT_GT(replans, 100);
+}
+
+INSTANTIATE_TEST_SUITE_P(RealMaps, DStarLiteOnExtract,
+                         ::testing::Values("monaco.osm.gz", "andorra.osm.pbf", "liechtenstein.osm.pbf"));
 
 }  // namespace
 }  // namespace corridor::planner

@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# Module dependencies point one way: maps <- planner <- preemption <- sim/server; localizer <- maps.
+# A module may include only itself and the modules below it. Usage: layering_test.sh SOURCE_DIR
+set -euo pipefail
+cd "$1"
+declare -A allowed=(
+  [maps]="maps"
+  [planner]="maps planner"
+  [preemption]="maps planner preemption"
+  [sim]="maps planner preemption sim"
+  [server]="maps planner preemption server"
+  [localizer]="maps localizer"
+  [bench]="maps planner preemption bench"
+)
+violations=0
+checked=0
+for module in "${!allowed[@]}"; do
+  [[ -d $module ]] || continue
+  while IFS=: read -r file _ include; do
+    target=$(sed -E 's/.*#include "([a-z_]+)\/.*/\1/' <<< "$include")
+    checked=$((checked + 1))
+    if [[ " ${allowed[$module]} " != *" $target "* ]]; then
+      echo "layering violation: $file includes $target/ ($module may use: ${allowed[$module]})"
+      violations=$((violations + 1))
+    fi
+  done < <(grep -rnE '#include "[a-z_]+/' "$module" --include='*.hpp' --include='*.cpp' || true)
+done
+echo "$checked includes checked, $violations violations"
+((checked > 0 && violations == 0))
