@@ -203,7 +203,10 @@ TEST(OsmImport, MissingFileIsAClearError) {
 TEST(OsmImport, CorruptPbfIsAClearError) {
   TempDir dir;
   const auto file = dir.path() / "broken.osm.pbf";
-  std::ofstream(file, std::ios::binary) << std::string("\x00\x00\x00\x0dthis is not a protobuf blob at all", 40);
+  // A plausible blob-header length prefix followed by junk.
+  std::string bytes("\x00\x00\x00\x0d", 4);
+  bytes += "this is not a protobuf blob at all";
+  std::ofstream(file, std::ios::binary) << bytes;
   try {
     OsmImportOptions options;
     options.show_progress = false;
