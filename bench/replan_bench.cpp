@@ -40,7 +40,7 @@ std::optional<EdgePoint> drive(const planner::TravelCost& cost, const planner::R
     if (left <= before_edge) return EdgePoint{e, from};
     left -= before_edge;
     const double t = cost.partial_time_s(e, from, to);
-    if (left < t) return EdgePoint{e, from + (left / t) * (to - from)};  // queue delay spread over the edge
+    if (left < t) return EdgePoint{e, from + (left / t) * (to - from)};  // as the cost model: delay spread
     left -= t;
   }
   return std::nullopt;

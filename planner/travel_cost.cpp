@@ -21,9 +21,8 @@ double TravelCost::partial_time_s(EdgeId e, double from_m, double to_m) const {
   from_m = std::clamp(from_m, 0.0, length);
   to_m = std::clamp(to_m, 0.0, length);
   const double fraction = (to_m - from_m) / length;
-  // 0 × ∞ (no distance on a closed edge) is 0: the vehicle is already there.
-  const double running = fraction <= 0.0 ? 0.0 : fraction * running_time_s(e);
-  return to_m >= length ? add_cost(running, overlay_->edge(e).queue_delay_s) : running;
+  // 0 × ∞ (no distance left on a closed edge) is 0: the vehicle is already there.
+  return fraction <= 0.0 ? 0.0 : fraction * edge_time_s(e);
 }
 
 }  // namespace corridor::planner

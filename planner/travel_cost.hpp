@@ -39,7 +39,10 @@ class TravelCost {
   // node cost into its out-edges makes node costs exact for every path through the node.
   [[nodiscard]] double transit_s(EdgeId e) const { return add_cost(node_delay_s(graph_->tail(e)), edge_time_s(e)); }
 
-  // Driving from offset `from_m` to `to_m` on e; the queue delay applies only when reaching the end.
+  // Driving from offset `from_m` to `to_m` on e. The queue delay is spread along the edge in
+  // proportion to distance: a position fix cannot tell whether a vehicle near the stop line is
+  // before or after the queue, and charging the whole delay to every position short of the end
+  // would charge a vehicle at the stop line for a queue it is already through.
   [[nodiscard]] double partial_time_s(EdgeId e, double from_m, double to_m) const;
 
   [[nodiscard]] double heuristic_s(maps::Point2 a, maps::Point2 b) const {

@@ -47,14 +47,16 @@ TEST(TravelCost, ClosedEdgeIsInfinite) {
   EXPECT_EQ(cost.partial_time_s(ab, 40.0, 40.0), 0.0);  // no distance left: already there
 }
 
-TEST(TravelCost, PartialTimeAddsQueueDelayOnlyWhenReachingTheEnd) {
+TEST(TravelCost, PartialTimeSpreadsQueueDelayAlongTheEdge) {
   const auto g = diamond();
   CostOverlay overlay(g);
   const EdgeId ab = edge_from_to(g, 1, 2);
   overlay.set_edge(ab, {1.0, 30.0});
   const TravelCost cost(g, overlay, {30.0});
-  EXPECT_DOUBLE_EQ(cost.partial_time_s(ab, 20.0, 70.0), 5.0);
-  EXPECT_DOUBLE_EQ(cost.partial_time_s(ab, 20.0, 100.0), 8.0 + 30.0);
+  EXPECT_DOUBLE_EQ(cost.partial_time_s(ab, 20.0, 70.0), 0.5 * 40.0);
+  EXPECT_DOUBLE_EQ(cost.partial_time_s(ab, 20.0, 100.0), 0.8 * 40.0);
+  EXPECT_DOUBLE_EQ(cost.partial_time_s(ab, 0.0, 100.0), cost.edge_time_s(ab));
+  EXPECT_DOUBLE_EQ(cost.partial_time_s(ab, 100.0, 100.0), 0.0);  // at the stop line: through the queue
 }
 
 TEST(TravelCost, TransitAddsTheTailIntersectionDelay) {
