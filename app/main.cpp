@@ -8,6 +8,7 @@
 #include "app/bench_command.hpp"
 #include "app/cli_error.hpp"
 #include "app/map_command.hpp"
+#include "app/preemption_command.hpp"
 #include "app/route_command.hpp"
 #include "maps/errors.hpp"
 
@@ -24,6 +25,7 @@ int main(int argc, char** argv) {
   corridor::app::register_route_command(app);
   corridor::app::register_map_command(app);
   corridor::app::register_bench_command(app);
+  corridor::app::register_preemption_command(app);
 
   try {
     app.parse(argc, argv);

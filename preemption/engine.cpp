@@ -1,0 +1,338 @@
+#include "preemption/engine.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "maps/intersection_geometry.hpp"
+
+namespace corridor::preemption {
+namespace {
+
+bool is_live(const ScheduleEntry& e) { return e.state == EntryState::planned || e.state == EntryState::active; }
+
+// Arbitration order: mission priority (higher first), then predicted arrival, then mission id.
+bool serves_first(const ScheduleEntry* a, const ScheduleEntry* b) {
+  if (a->priority != b->priority) return a->priority > b->priority;
+  if (a->arrival_s != b->arrival_s) return a->arrival_s < b->arrival_s;
+  return a->mission < b->mission;
+}
+
+bool phases_conflict(const maps::SignalPlan& plan, const maps::Phase& a, const maps::Phase& b) {
+  for (std::size_t m = 0; m < plan.movements.size(); ++m) {
+    if (!a.serves(m)) continue;
+    for (std::size_t k = 0; k < plan.movements.size(); ++k) {
+      if (b.serves(k) && plan.conflicts(m, k)) return true;
+    }
+  }
+  return false;
+}
+
+std::string fmt_s(double t) {
+  std::ostringstream out;
+  out.precision(1);
+  out << std::fixed << t;
+  return out.str();
+}
+
+}  // namespace
+
+const char* to_string(EntryState s) {
+  switch (s) {
+    case EntryState::planned: return "planned";
+    case EntryState::active: return "active";
+    case EntryState::released: return "released";
+    case EntryState::cancelled: return "cancelled";
+    case EntryState::expired: return "expired";
+  }
+  return "?";
+}
+
+std::vector<Crossing> signalized_crossings(const planner::Route& route,
+                                           const std::unordered_map<NodeId, maps::SignalPlan>& plans, double now_s) {
+  std::vector<Crossing> out;
+  for (std::size_t i = 0; i < route.nodes.size() && i + 1 < route.edges.size(); ++i) {
+    if (plans.count(route.nodes[i]) == 0) continue;
+    out.push_back({route.nodes[i], route.edges[i], route.edges[i + 1], now_s + route.arrival_s[i]});
+  }
+  return out;
+}
+
+PreemptionEngine::PreemptionEngine(const maps::RoadGraph& graph, const std::unordered_map<NodeId, maps::SignalPlan>& plans,
+                                   SignalController& controller, PreemptionConfig config)
+    : graph_(graph), plans_(plans), controller_(controller), config_(config) {}
+
+void PreemptionEngine::log(double t, MissionId m, NodeId n, std::string kind, std::string detail) {
+  spdlog::info("event=preemption_{} t={:.1f} mission={} node={} {}", kind, t, m, n.v, detail);
+  events_.push_back({t, m, n, std::move(kind), std::move(detail)});
+}
+
+bool PreemptionEngine::time_entry(ScheduleEntry& e, const Crossing& c, double now_s) {
+  const maps::SignalPlan& plan = plans_.at(c.node);
+  const maps::Compass from = maps::approach_side(graph_, c.in_edge);
+  std::optional<std::size_t> movement = plan.movement_index(from, maps::exit_side(graph_, c.out_edge));
+  if (!movement) {
+    // Leaving by the side it came from (a U-turn) or by a leg the plan merged: the approach's
+    // through movement stands for it; every phase choice below depends on the approach.
+    for (std::size_t m = 0; m < plan.movements.size() && !movement; ++m) {
+      if (plan.movements[m].from == from) movement = m;
+    }
+  }
+  if (!movement) return false;
+  e.node = c.node;
+  e.movement = *movement;
+  e.movement_label = plan.movements[*movement].label();
+  e.arrival_s = c.arrival_s;
+
+  const QueueEstimator* queue = nullptr;
+  if (auto it = queues_.find(c.node); it != queues_.end() && it->second.has_data(from)) queue = &it->second;
+  ApproachMeasurement measured;
+  if (queue != nullptr) measured.queue_veh = queue->queue_now(from);
+  e.congestion = classify_congestion(measured, config_.congestion);
+
+  // An active hold keeps its phase unless the vehicle's movement changed.
+  const bool keep = e.state == EntryState::active && e.phase.serves(e.movement);
+  const PhaseDecision decision = select_phase(plan, e.movement, controller_.current_phase(c.node), e.congestion);
+  if (!keep) e.phase = decision.phase;
+
+  // Gedawy: p = τ − Trans − margin (− t_q(τ) under congestion).
+  const double trans = decision.extend || keep
+                           ? 0.0
+                           : transition_time_s(controller_.remaining_min_green_s(c.node, now_s), plan.yellow_s, plan.all_red_s);
+  double clearance = 0.0;
+  if (e.congestion == CongestionLevel::high && queue != nullptr) {
+    QueueInputs q;
+    q.arrivals_at_tau = queue->arrivals_at(from, e.arrival_s);
+    const std::optional<double> green_start = controller_.green_start_s(c.node, e.movement);
+    q.green_on = green_start.has_value();
+    q.green_start_s = green_start.value_or(now_s);
+    q.departures_at_green_start = queue->departures_at(from, q.green_start_s);
+    q.departures_at_green_end = queue->departures_at(from, now_s);
+    clearance = queue_clearance_s(queue_at_arrival_veh(e.arrival_s, q, config_.timing), config_.timing);
+  }
+  e.natural_start_s = std::max(now_s, preemption_start_s(e.arrival_s, trans, clearance, config_.timing));
+  if (e.state == EntryState::active) e.natural_start_s = std::min(e.natural_start_s, e.started_s);
+  e.release_s = e.arrival_s + config_.release_after_arrival_s;
+  return true;
+}
+
+void PreemptionEngine::arbitrate(NodeId node, double now_s) {
+  NodeState& ns = nodes_[node];
+  const maps::SignalPlan& plan = plans_.at(node);
+  std::sort(ns.entries.begin(), ns.entries.end(), serves_first);
+  std::vector<const ScheduleEntry*> accepted;
+  for (ScheduleEntry* e : ns.entries) {
+    const bool was_deferred = e->deferred;
+    e->start_s = e->natural_start_s;
+    e->deferred = false;
+    // Each claim waits for every conflicting claim ahead of it, even one already holding: a
+    // higher-priority vehicle takes the signal, and the one it displaces is served right after.
+    for (bool moved = true; moved;) {
+      moved = false;
+      for (const ScheduleEntry* a : accepted) {
+        const bool overlap = e->start_s < a->release_s && a->start_s < e->release_s;
+        if (overlap && phases_conflict(plan, e->phase, a->phase)) {
+          e->start_s = a->release_s + plan.yellow_s + plan.all_red_s;
+          e->release_s = std::max(e->release_s, e->start_s + config_.release_after_arrival_s);
+          e->deferred = moved = true;
+        }
+      }
+    }
+    if (e->deferred && e->state == EntryState::active && e->start_s > now_s) e->state = EntryState::planned;
+    if (e->deferred && !was_deferred) {
+      log(now_s, e->mission, node, "deferred",
+          "phase=" + e->phase.label + " start_s=" + fmt_s(e->start_s) + " reason=conflicting_higher_claim");
+    }
+    accepted.push_back(e);
+  }
+}
+
+std::size_t PreemptionEngine::recovery_step(NodeId node, const NodeState& ns, double) const {
+  // Documented recovery phase: the program step serving the approach with the longest measured
+  // queue; without detector data, the step serving most of the movements the hold kept red.
+  const maps::SignalPlan& plan = plans_.at(node);
+  std::vector<double> weight(plan.movements.size(), 0.0);
+  bool measured = false;
+  if (auto it = queues_.find(node); it != queues_.end()) {
+    for (std::size_t m = 0; m < plan.movements.size(); ++m) {
+      if (it->second.has_data(plan.movements[m].from)) {
+        weight[m] = it->second.queue_now(plan.movements[m].from);
+        measured = measured || weight[m] > 0.0;
+      }
+    }
+  }
+  if (!measured) {
+    for (std::size_t m = 0; m < plan.movements.size(); ++m) weight[m] = m < ns.red_while_held.size() ? ns.red_while_held[m] : 0;
+  }
+  std::size_t best = 0;
+  double best_score = -1.0;
+  for (std::size_t step = 0; step < plan.program.size(); ++step) {
+    double score = 0.0;
+    for (std::size_t m = 0; m < plan.movements.size(); ++m) {
+      if (plan.phases[plan.program[step].phase].serves(m)) score = measured ? std::max(score, weight[m]) : score + weight[m];
+    }
+    if (score > best_score) {
+      best_score = score;
+      best = step;
+    }
+  }
+  return best;
+}
+
+void PreemptionEngine::refresh_node(NodeId node, double now_s) {
+  NodeState& ns = nodes_[node];
+  const maps::SignalPlan& plan = plans_.at(node);
+  std::vector<std::uint8_t> want(plan.movements.size(), 0);
+  std::string label;
+  double min_green = 0.0;
+  for (ScheduleEntry* e : ns.entries) {
+    if (e->start_s > now_s) continue;
+    // Arbitration made every overlapping pair compatible, so the union of their phases is safe.
+    if (phases_conflict(plan, e->phase, maps::Phase{"", want, 0.0})) continue;
+    if (e->state == EntryState::planned) {
+      e->state = EntryState::active;
+      e->started_s = now_s;
+      log(now_s, e->mission, node, "started",
+          "phase=" + e->phase.label + " arrival_s=" + fmt_s(e->arrival_s) + " movement=" + e->movement_label);
+    }
+    for (std::size_t m = 0; m < want.size(); ++m) want[m] = want[m] || e->phase.serves(m);
+    if (label.find(e->phase.label) == std::string::npos) label += (label.empty() ? "" : "|") + e->phase.label;
+    min_green = std::max(min_green, e->phase.min_green_s);
+  }
+  const bool any = std::find(want.begin(), want.end(), 1) != want.end();
+  if (any) {
+    if (ns.red_while_held.empty()) ns.red_while_held.assign(want.size(), 0);
+    for (std::size_t m = 0; m < want.size(); ++m) ns.red_while_held[m] = ns.red_while_held[m] || !want[m];
+    if (want != ns.held) {
+      controller_.hold(node, maps::Phase{label, want, min_green}, now_s);
+      ns.held = want;
+    }
+  } else if (!ns.held.empty()) {
+    const std::size_t step = recovery_step(node, ns, now_s);
+    controller_.release(node, step, now_s);
+    log(now_s, 0, node, "recovered", "resume_step=" + std::to_string(step));
+    ns.held.clear();
+    ns.red_while_held.clear();
+  }
+}
+
+void PreemptionEngine::finish(ScheduleEntry& e, EntryState state, double now_s, const std::string& detail) {
+  e.state = state;
+  auto& list = nodes_[e.node].entries;
+  list.erase(std::remove(list.begin(), list.end(), &e), list.end());
+  log(now_s, e.mission, e.node, to_string(state), detail);
+}
+
+void PreemptionEngine::update_route(MissionId mission, int priority, std::span<const Crossing> crossings, double now_s) {
+  auto& entries = missions_[mission];
+  std::vector<NodeId> touched;
+  std::vector<NodeId> on_route;
+  for (const Crossing& c : crossings) {
+    if (plans_.count(c.node) == 0 || std::find(on_route.begin(), on_route.end(), c.node) != on_route.end()) continue;
+    on_route.push_back(c.node);
+    ScheduleEntry* existing = nullptr;
+    for (auto& e : entries) {
+      if (e->node == c.node && is_live(*e)) existing = e.get();
+    }
+    if (existing != nullptr) {
+      const double before = existing->natural_start_s;
+      existing->priority = priority;
+      if (!time_entry(*existing, c, now_s)) {
+        finish(*existing, EntryState::cancelled, now_s, "reason=no_movement");
+      } else if (std::abs(existing->natural_start_s - before) > 0.5) {
+        log(now_s, mission, c.node, "retimed", "start_s=" + fmt_s(existing->natural_start_s) + " arrival_s=" + fmt_s(existing->arrival_s));
+      }
+    } else {
+      auto e = std::make_unique<ScheduleEntry>();
+      e->mission = mission;
+      e->priority = priority;
+      if (!time_entry(*e, c, now_s)) continue;
+      log(now_s, mission, c.node, "scheduled",
+          "phase=" + e->phase.label + " start_s=" + fmt_s(e->natural_start_s) + " arrival_s=" + fmt_s(e->arrival_s) +
+              " congestion=" + (e->congestion == CongestionLevel::high ? "high" : "low"));
+      nodes_[c.node].entries.push_back(e.get());
+      entries.push_back(std::move(e));
+    }
+    touched.push_back(c.node);
+  }
+  for (auto& e : entries) {
+    if (is_live(*e) && std::find(on_route.begin(), on_route.end(), e->node) == on_route.end()) {
+      finish(*e, EntryState::cancelled, now_s, "reason=route_left_intersection");
+      touched.push_back(e->node);
+    }
+  }
+  for (NodeId n : touched) {
+    arbitrate(n, now_s);
+    refresh_node(n, now_s);
+  }
+}
+
+void PreemptionEngine::vehicle_passed(MissionId mission, NodeId node, double now_s) {
+  auto it = missions_.find(mission);
+  if (it == missions_.end()) return;
+  for (auto& e : it->second) {
+    if (e->node == node && is_live(*e)) {
+      finish(*e, EntryState::released, now_s, "reason=vehicle_cleared_stop_line");
+      arbitrate(node, now_s);
+      refresh_node(node, now_s);
+    }
+  }
+}
+
+void PreemptionEngine::cancel(MissionId mission, double now_s) {
+  auto it = missions_.find(mission);
+  if (it == missions_.end()) return;
+  for (auto& e : it->second) {
+    if (!is_live(*e)) continue;
+    finish(*e, EntryState::cancelled, now_s, "reason=mission_cancelled");
+    arbitrate(e->node, now_s);
+    refresh_node(e->node, now_s);
+  }
+}
+
+void PreemptionEngine::record_counts(NodeId node, maps::Compass approach, double time_s, double arrivals,
+                                     double departures) {
+  if (plans_.count(node) == 0) throw CountError("node " + std::to_string(node.v) + " has no signal");
+  queues_[node].record(approach, time_s, arrivals, departures);
+}
+
+void PreemptionEngine::tick(double now_s) {
+  for (auto& [node, ns] : nodes_) {
+    // Copy: finish() edits the list.
+    const std::vector<ScheduleEntry*> live = ns.entries;
+    for (ScheduleEntry* e : live) {
+      // Bounded recovery: a vehicle that never arrives cannot hold a signal for long.
+      if (now_s > e->arrival_s + config_.max_overrun_s) {
+        finish(*e, EntryState::expired, now_s, "reason=vehicle_overdue");
+      } else if (e->state == EntryState::active && now_s > e->started_s + config_.max_hold_s) {
+        finish(*e, EntryState::expired, now_s, "reason=max_hold");
+      }
+    }
+    arbitrate(node, now_s);
+    refresh_node(node, now_s);
+  }
+}
+
+std::vector<ScheduleEntry> PreemptionEngine::schedule(MissionId mission) const {
+  std::vector<ScheduleEntry> out;
+  if (auto it = missions_.find(mission); it != missions_.end()) {
+    for (const auto& e : it->second) out.push_back(*e);
+  }
+  std::sort(out.begin(), out.end(), [](const ScheduleEntry& a, const ScheduleEntry& b) { return a.arrival_s < b.arrival_s; });
+  return out;
+}
+
+std::vector<PreemptionEvent> PreemptionEngine::take_events() {
+  std::vector<PreemptionEvent> out;
+  out.swap(events_);
+  return out;
+}
+
+bool PreemptionEngine::holding(NodeId node) const {
+  auto it = nodes_.find(node);
+  return it != nodes_.end() && !it->second.held.empty();
+}
+
+}  // namespace corridor::preemption

@@ -1,0 +1,120 @@
+// The preemption engine: for every signalized intersection on each emergency vehicle's route it
+// picks the phase, times the start (Gedawy's equations), arbitrates between vehicles, drives the
+// SignalController, and restores the normal program behind the vehicle. Time is the caller's.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <span>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "maps/road_graph.hpp"
+#include "maps/signal_plan.hpp"
+#include "planner/route.hpp"
+#include "preemption/congestion_classifier.hpp"
+#include "preemption/phase_selection.hpp"
+#include "preemption/queue_estimator.hpp"
+#include "preemption/signal_controller.hpp"
+#include "preemption/timing.hpp"
+
+namespace corridor::preemption {
+
+using MissionId = std::uint64_t;
+
+struct PreemptionConfig {
+  TimingConfig timing;
+  CongestionClassifierConfig congestion;
+  double release_after_arrival_s = 8.0;  // planned release: the vehicle is through the junction
+  double max_overrun_s = 60.0;           // a vehicle this late past its predicted arrival: expire
+  double max_hold_s = 180.0;             // no hold lasts longer than this, whatever happens
+};
+
+// One signalized intersection on a route.
+struct Crossing {
+  NodeId node;
+  EdgeId in_edge;
+  EdgeId out_edge;
+  double arrival_s = 0;  // predicted arrival at the stop line, absolute time
+};
+
+// The signalized crossings of a planned route, with arrivals relative to `now_s`.
+std::vector<Crossing> signalized_crossings(const planner::Route& route,
+                                           const std::unordered_map<NodeId, maps::SignalPlan>& plans, double now_s);
+
+enum class EntryState { planned, active, released, cancelled, expired };
+const char* to_string(EntryState s);
+
+struct ScheduleEntry {
+  MissionId mission = 0;
+  int priority = 0;
+  NodeId node;
+  std::size_t movement = 0;
+  std::string movement_label;
+  maps::Phase phase;
+  CongestionLevel congestion = CongestionLevel::low;
+  double natural_start_s = 0;  // from the timing equations alone
+  double start_s = 0;          // after arbitration
+  double started_s = 0;        // when the hold began (active entries)
+  double arrival_s = 0;
+  double release_s = 0;
+  EntryState state = EntryState::planned;
+  bool deferred = false;  // lost arbitration: served right after the winner
+};
+
+struct PreemptionEvent {
+  double time_s;
+  MissionId mission;
+  NodeId node;
+  std::string kind;  // scheduled, retimed, started, released, cancelled, expired, deferred
+  std::string detail;
+};
+
+class PreemptionEngine {
+ public:
+  PreemptionEngine(const maps::RoadGraph& graph, const std::unordered_map<NodeId, maps::SignalPlan>& plans,
+                   SignalController& controller, PreemptionConfig config = {});
+
+  // The mission's current route (after every replan): re-times its crossings, schedules new ones,
+  // and cancels those the route no longer crosses.
+  void update_route(MissionId mission, int priority, std::span<const Crossing> crossings, double now_s);
+  // The vehicle cleared the stop line: release the signal behind it.
+  void vehicle_passed(MissionId mission, NodeId node, double now_s);
+  void cancel(MissionId mission, double now_s);
+  // Detector counts for the queue estimate. Throws CountError for bad counts.
+  void record_counts(NodeId node, maps::Compass approach, double time_s, double arrivals, double departures);
+  // Starts holds whose time has come, expires overdue ones, and releases signals no one holds.
+  void tick(double now_s);
+
+  [[nodiscard]] std::vector<ScheduleEntry> schedule(MissionId mission) const;
+  [[nodiscard]] std::vector<PreemptionEvent> take_events();
+  [[nodiscard]] bool holding(NodeId node) const;
+
+ private:
+  struct NodeState {
+    std::vector<ScheduleEntry*> entries;       // live (planned or active) entries of all missions
+    std::vector<std::uint8_t> held;            // the green set being held; empty when not holding
+    std::vector<std::uint8_t> red_while_held;  // movements kept red by the holds, for recovery
+  };
+
+  // False when the crossing has no movement in the plan (a U-turn into the approach it came from).
+  bool time_entry(ScheduleEntry& e, const Crossing& c, double now_s);
+  void arbitrate(NodeId node, double now_s);
+  void finish(ScheduleEntry& e, EntryState state, double now_s, const std::string& detail);
+  void refresh_node(NodeId node, double now_s);
+  [[nodiscard]] std::size_t recovery_step(NodeId node, const NodeState& ns, double now_s) const;
+  void log(double t, MissionId m, NodeId n, std::string kind, std::string detail);
+
+  const maps::RoadGraph& graph_;
+  const std::unordered_map<NodeId, maps::SignalPlan>& plans_;
+  SignalController& controller_;
+  PreemptionConfig config_;
+  std::map<MissionId, std::vector<std::unique_ptr<ScheduleEntry>>> missions_;
+  std::unordered_map<NodeId, NodeState> nodes_;
+  std::unordered_map<NodeId, QueueEstimator> queues_;
+  std::vector<PreemptionEvent> events_;
+};
+
+}  // namespace corridor::preemption

@@ -1,0 +1,284 @@
+#include "preemption/engine.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "maps/graph_builder.hpp"
+#include "maps/intersection_geometry.hpp"
+#include "maps/synthetic_grid.hpp"
+#include "planner/one_to_one_search.hpp"
+#include "preemption/safety_monitor.hpp"
+#include "preemption/simulated_signal_controller.hpp"
+
+namespace corridor::preemption {
+namespace {
+
+// A four-legged signalized junction C at the origin, with legs 200 m to the N, E, S and W.
+maps::RoadGraph plus_junction() {
+  maps::GraphBuildInput in;
+  in.origin = {47.0, 9.5};
+  in.node_pos = {{0, 0}, {0, 200}, {200, 0}, {0, -200}, {-200, 0}};
+  for (std::int64_t i = 0; i < 5; ++i) in.node_osm.push_back(OsmNodeId{i + 1});
+  in.node_signalized = {1, 0, 0, 0, 0};
+  for (std::uint32_t leg = 1; leg <= 4; ++leg) {
+    maps::RoadSegment s;
+    s.from = 0;
+    s.to = leg;
+    s.first_point = static_cast<std::uint32_t>(in.points.size());
+    in.points.push_back(in.node_pos[0]);
+    in.points.push_back(in.node_pos[leg]);
+    s.last_point = s.first_point + 1;
+    s.forward_speed_mps = s.backward_speed_mps = 14.0f;
+    s.way = OsmWayId{leg};
+    in.segments.push_back(s);
+  }
+  return maps::build_road_graph(in);
+}
+
+EdgeId edge(const maps::RoadGraph& g, std::int64_t from_osm, std::int64_t to_osm) {
+  for (EdgeId e : g.edges()) {
+    if (g.osm_node(g.tail(e)).v == from_osm && g.osm_node(g.head(e)).v == to_osm) return e;
+  }
+  return kInvalidEdge;
+}
+
+constexpr std::int64_t kC = 1, kN = 2, kE = 3, kS = 4, kW = 5;
+
+struct Rig {
+  maps::RoadGraph graph = plus_junction();
+  std::unordered_map<NodeId, maps::SignalPlan> plans = maps::default_signal_plans(graph);
+  SimulatedSignalController controller{plans, 0.0};
+  SafetyMonitor monitor;
+  PreemptionEngine engine{graph, plans, controller};
+  NodeId c = graph.head(edge(graph, kN, kC));
+
+  Rig() {
+    for (const auto& [node, plan] : plans) monitor.watch(plan, controller.lights(node), 0.0);
+    controller.set_observer([this](NodeId n, const std::vector<Light>& l, double t) { monitor.observe(n, l, t); });
+  }
+  Crossing crossing(std::int64_t from, std::int64_t to, double arrival_s) {
+    return {c, edge(graph, from, kC), edge(graph, kC, to), arrival_s};
+  }
+  void run_until(double t) {
+    controller.advance(t);
+    engine.tick(t);
+  }
+  const maps::SignalPlan& plan() { return plans.at(c); }
+};
+
+TEST(PreemptionEngine, DefaultPlanHasFourLegs) {
+  Rig rig;
+  ASSERT_EQ(rig.plans.size(), 1u);
+  EXPECT_EQ(rig.plan().movements.size(), 12u);
+}
+
+// At 0 s the program shows 4+7 (min green 5 s). A vehicle going East -> West, due at 60 s, needs a
+// phase with movement 6: 2+6 serves the West approach too, so it wins over 1+6. Trans = 5 + 3 + 2
+// = 10 s, margin 3 s: start at 47 s; released 8 s after arrival.
+TEST(PreemptionEngine, SchedulesTheChosenPhaseAtTheComputedStart) {
+  Rig rig;
+  const std::vector<Crossing> route{rig.crossing(kE, kW, 60.0)};
+  rig.engine.update_route(1, 1, route, 0.0);
+  const auto schedule = rig.engine.schedule(1);
+  ASSERT_EQ(schedule.size(), 1u);
+  EXPECT_EQ(schedule[0].phase.label, "2+6");
+  EXPECT_EQ(schedule[0].movement_label, "E->W");
+  EXPECT_DOUBLE_EQ(schedule[0].start_s, 47.0);
+  EXPECT_DOUBLE_EQ(schedule[0].arrival_s, 60.0);
+  EXPECT_DOUBLE_EQ(schedule[0].release_s, 68.0);
+  EXPECT_EQ(schedule[0].state, EntryState::planned);
+  rig.run_until(46.9);
+  EXPECT_FALSE(rig.engine.holding(rig.c));
+  rig.run_until(47.0);
+  EXPECT_TRUE(rig.engine.holding(rig.c));
+  EXPECT_EQ(rig.engine.schedule(1)[0].state, EntryState::active);
+  // The vehicle's movement is green by its arrival.
+  rig.run_until(60.0);
+  const std::size_t e_w = *rig.plan().movement_index(maps::Compass::east, maps::Compass::west);
+  EXPECT_EQ(rig.controller.lights(rig.c)[e_w], Light::green);
+  rig.engine.vehicle_passed(1, rig.c, 61.0);
+  EXPECT_EQ(rig.engine.schedule(1)[0].state, EntryState::released);
+  EXPECT_FALSE(rig.engine.holding(rig.c));
+  rig.run_until(61.0 + 5.0 + 2 * (3.0 + 2.0));
+  EXPECT_TRUE(rig.controller.running_program(rig.c));
+  EXPECT_TRUE(rig.monitor.violations().empty()) << rig.monitor.violations().front();
+}
+
+TEST(PreemptionEngine, ExtendsAPhaseThatAlreadyServesTheVehicle) {
+  Rig rig;
+  const std::vector<Crossing> route{rig.crossing(kN, kS, 30.0)};
+  rig.engine.update_route(1, 1, route, 0.0);
+  const auto s = rig.engine.schedule(1)[0];
+  EXPECT_EQ(s.phase.label, "4+7");  // on show at 0 s and serving N->S: no transition needed
+  EXPECT_DOUBLE_EQ(s.start_s, 30.0 - 3.0);
+}
+
+TEST(PreemptionEngine, VehicleThatNeverArrivesExpiresAndTheSignalRecovers) {
+  Rig rig;
+  const std::vector<Crossing> route{rig.crossing(kS, kN, 40.0)};
+  rig.engine.update_route(7, 1, route, 0.0);
+  for (double t = 0; t <= 40.0 + 60.0; t += 1.0) rig.run_until(t);
+  EXPECT_TRUE(rig.engine.holding(rig.c));  // still waiting within the allowed overrun
+  rig.run_until(101.0);
+  EXPECT_EQ(rig.engine.schedule(7)[0].state, EntryState::expired);
+  EXPECT_FALSE(rig.engine.holding(rig.c));
+  rig.run_until(101.0 + 5.0 + 2 * (3.0 + 2.0));
+  EXPECT_TRUE(rig.controller.running_program(rig.c));
+  EXPECT_TRUE(rig.monitor.violations().empty());
+}
+
+TEST(PreemptionEngine, RerouteAwayCancelsAndReleases) {
+  Rig rig;
+  const std::vector<Crossing> route{rig.crossing(kW, kE, 20.0)};
+  rig.engine.update_route(3, 1, route, 0.0);
+  rig.run_until(19.0);
+  EXPECT_TRUE(rig.engine.holding(rig.c));
+  rig.engine.update_route(3, 1, {}, 19.5);  // the new route avoids the junction
+  EXPECT_EQ(rig.engine.schedule(3)[0].state, EntryState::cancelled);
+  EXPECT_FALSE(rig.engine.holding(rig.c));
+  const auto events = rig.engine.take_events();
+  EXPECT_TRUE(std::any_of(events.begin(), events.end(), [](const PreemptionEvent& e) { return e.kind == "cancelled"; }));
+}
+
+TEST(PreemptionEngine, RetimesWhenTheArrivalEstimateChanges) {
+  Rig rig;
+  std::vector<Crossing> route{rig.crossing(kE, kW, 60.0)};
+  rig.engine.update_route(1, 1, route, 0.0);
+  route[0].arrival_s = 90.0;  // the vehicle got slower
+  rig.engine.update_route(1, 1, route, 1.0);
+  EXPECT_DOUBLE_EQ(rig.engine.schedule(1)[0].arrival_s, 90.0);
+  // At 1 s, 4+7 still owes 4 s of min green: Trans = 4 + 3 + 2 = 9 s, so p = 90 − 9 − 3 = 78 s.
+  EXPECT_DOUBLE_EQ(rig.engine.schedule(1)[0].start_s, 78.0);
+}
+
+// Conflicting movements: the higher priority is served first, the other right after; with equal
+// priorities the earlier arrival goes first. Deterministic, and logged.
+TEST(PreemptionEngine, ArbitratesConflictingVehiclesByPriorityThenArrival) {
+  for (const auto& [prio_a, prio_b, winner] : {std::tuple{1, 2, 2}, std::tuple{2, 1, 1}, std::tuple{1, 1, 1}}) {
+    Rig rig;
+    const std::vector<Crossing> a{rig.crossing(kN, kS, 60.0)};
+    const std::vector<Crossing> b{rig.crossing(kE, kW, 62.0)};
+    rig.engine.update_route(1, prio_a, a, 0.0);
+    rig.engine.update_route(2, prio_b, b, 0.0);
+    const auto sa = rig.engine.schedule(1)[0];
+    const auto sb = rig.engine.schedule(2)[0];
+    const auto& win = winner == 1 ? sa : sb;
+    const auto& lose = winner == 1 ? sb : sa;
+    EXPECT_FALSE(win.deferred);
+    EXPECT_TRUE(lose.deferred);
+    EXPECT_GE(lose.start_s, win.release_s + 3.0 + 2.0);
+    const auto events = rig.engine.take_events();
+    EXPECT_TRUE(std::any_of(events.begin(), events.end(), [&](const PreemptionEvent& e) {
+      return e.kind == "deferred" && e.mission == lose.mission;
+    }));
+    for (double t = 0; t < 200; t += 0.5) {
+      rig.run_until(t);
+      if (t == 70.0) rig.engine.vehicle_passed(win.mission, rig.c, t);
+    }
+    EXPECT_TRUE(rig.monitor.violations().empty());
+  }
+}
+
+// A queue on the approach makes it high congestion: the whole approach gets green, and earlier by
+// the queue clearance time.
+TEST(PreemptionEngine, QueueOnTheApproachStartsEarlierWithTheWholeApproach) {
+  Rig rig;
+  rig.engine.record_counts(rig.c, maps::Compass::east, 0.0, 0.0, 0.0);
+  rig.engine.record_counts(rig.c, maps::Compass::east, 10.0, 10.0, 0.0);  // 10 queued, 1 veh/s arriving
+  const std::vector<Crossing> route{rig.crossing(kE, kW, 60.0)};
+  rig.engine.update_route(1, 1, route, 10.0);
+  const auto s = rig.engine.schedule(1)[0];
+  EXPECT_EQ(s.congestion, CongestionLevel::high);
+  EXPECT_EQ(s.phase.label, "1+6");
+  // Red on E->W: n_q = A(60) − D(now) = (10 + 1 × 50) − 0 = 60 vehicles; t_q = 2 + 2 × 60 = 122 s,
+  // so the start is as soon as possible: now.
+  EXPECT_DOUBLE_EQ(s.start_s, 10.0);
+  EXPECT_THROW(rig.engine.record_counts(rig.c, maps::Compass::east, 5.0, 1.0, 0.0), CountError);
+}
+
+// Property test: many random missions with planner routes over a grid of signalized junctions,
+// random arrivals (some vehicles never come), reroutes and cancels. No safety violation ever, and
+// every junction is back in its normal program within a bounded time once the missions are over.
+TEST(PreemptionEngine, RandomMissionsNeverBreakSafetyAndSignalsRecover) {
+  for (std::uint64_t seed = 1; seed <= 12; ++seed) {
+    maps::GridSpec spec;
+    spec.rows = 7;
+    spec.cols = 7;
+    spec.seed = seed;
+    spec.signal_fraction = 0.6;
+    const maps::RoadGraph g = maps::make_perturbed_grid(spec);
+    const auto plans = maps::default_signal_plans(g);
+    SimulatedSignalController controller(plans, 0.0);
+    SafetyMonitor monitor;
+    for (const auto& [node, plan] : plans) monitor.watch(plan, controller.lights(node), 0.0);
+    controller.set_observer([&](NodeId n, const std::vector<Light>& l, double t) { monitor.observe(n, l, t); });
+    PreemptionEngine engine(g, plans, controller);
+    planner::CostOverlay overlay(g);
+    const planner::TravelCost cost(g, overlay, {15.0});
+    planner::OneToOneSearch search;
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    auto random_route = [&](double now) {
+      const EdgeId a{static_cast<std::uint32_t>(rng() % g.edge_count())};
+      const EdgeId b{static_cast<std::uint32_t>(rng() % g.edge_count())};
+      const auto r = search.run(planner::SearchSpace(cost, {{a, 0.0}}, {{b, g.length_m(b)}}), true);
+      auto crossings = signalized_crossings(r, plans, now);
+      for (auto& c : crossings) c.arrival_s += unit(rng) * 20.0 - 10.0;  // imperfect predictions
+      return crossings;
+    };
+    std::map<MissionId, std::vector<Crossing>> live;
+    double t = 0.0;
+    MissionId next_id = 1;
+    for (int step = 0; step < 400; ++step) {
+      t += unit(rng) * 4.0;
+      controller.advance(t);
+      const double r = unit(rng);
+      if (r < 0.15 || live.empty()) {
+        const MissionId id = next_id++;
+        live[id] = random_route(t);
+        engine.update_route(id, static_cast<int>(rng() % 3), live[id], t);
+      } else if (r < 0.3) {
+        auto it = std::next(live.begin(), static_cast<long>(rng() % live.size()));
+        it->second = random_route(t);
+        engine.update_route(it->first, 1, it->second, t);
+      } else if (r < 0.35) {
+        auto it = std::next(live.begin(), static_cast<long>(rng() % live.size()));
+        engine.cancel(it->first, t);
+        live.erase(it);
+      }
+      // Vehicles pass the junctions they are due at, except a few that never show up.
+      for (auto& [id, crossings] : live) {
+        for (const Crossing& c : crossings) {
+          if (c.arrival_s <= t && c.arrival_s > t - 4.0 && unit(rng) < 0.8) engine.vehicle_passed(id, c.node, t);
+        }
+      }
+      engine.tick(t);
+    }
+    // No new missions: after the longest overrun everything has expired or been released.
+    const double end = t + 60.0 + 180.0 + 40.0;
+    for (double u = t; u <= end; u += 1.0) {
+      controller.advance(u);
+      engine.tick(u);
+    }
+    // Back in the normal program: never held again, and every junction shows a program phase
+    // within one clearance plus one cycle.
+    double horizon = 0.0;
+    for (const auto& [node, plan] : plans) {
+      EXPECT_FALSE(engine.holding(node)) << "seed " << seed;
+      EXPECT_EQ(controller.mode(node), SignalMode::program) << "seed " << seed;
+      horizon = std::max(horizon, 10.0 + 2 * (plan.yellow_s + plan.all_red_s) + plan.cycle_s());
+    }
+    std::unordered_map<NodeId, bool> program_phase_shown;
+    for (double u = end; u <= end + horizon; u += 0.5) {
+      controller.advance(u);
+      for (const auto& [node, plan] : plans) program_phase_shown[node] |= controller.running_program(node);
+    }
+    for (const auto& [node, shown] : program_phase_shown) EXPECT_TRUE(shown) << "seed " << seed << " node " << node.v;
+    ASSERT_TRUE(monitor.violations().empty()) << "seed " << seed << ": " << monitor.violations().front();
+    EXPECT_GT(monitor.changes_observed(), 100u);
+  }
+}
+
+}  // namespace
+}  // namespace corridor::preemption
