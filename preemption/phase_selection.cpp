@@ -1,5 +1,6 @@
 #include "preemption/phase_selection.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace corridor::preemption {
@@ -52,21 +53,22 @@ PhaseDecision select_phase(const maps::SignalPlan& plan, std::size_t movement, s
   }
   if (candidates.empty()) return {synthesize(plan, movement), std::nullopt, false};
 
+  // Only a safe phase that serves the movement may be extended; a SUMO phase with permissive
+  // greens serves it but is not safe to hold.
+  const bool current_is_candidate =
+      current && std::find(candidates.begin(), candidates.end(), *current) != candidates.end();
   std::size_t best = candidates.front();
   if (level == CongestionLevel::high) {
     // Every movement of the approach, so the queue in front of the vehicle discharges with it.
     for (std::size_t p : candidates) {
       if (approach_movements_served(plan, plan.phases[p], from) > approach_movements_served(plan, plan.phases[best], from)) best = p;
     }
-    if (current && approach_movements_served(plan, plan.phases[*current], from) ==
-                       approach_movements_served(plan, plan.phases[best], from) &&
-        plan.phases[*current].serves(movement)) {
+    if (current_is_candidate && approach_movements_served(plan, plan.phases[*current], from) ==
+                                    approach_movements_served(plan, plan.phases[best], from)) {
       best = *current;
     }
   } else {
-    if (current && *current < plan.phases.size() && plan.phases[*current].serves(movement)) {
-      return {plan.phases[*current], *current, true};
-    }
+    if (current_is_candidate) return {plan.phases[*current], *current, true};
     for (std::size_t p : candidates) {
       if (other_approach_score(plan, plan.phases[p], from, demand) > other_approach_score(plan, plan.phases[best], from, demand)) {
         best = p;

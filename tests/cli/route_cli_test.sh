@@ -134,5 +134,20 @@ assert j["mismatches"] == 0, j["mismatches"]
 PY
 then pass; else fail "bench replan output"; fi
 
+# 6. The preemption tables: the JSON contract, and 1/8 of the cells agree.
+"$corridor" preemption tables --json > "$work/tables.json"
+if python3 - "$work/tables.json" <<'PY'
+import json, sys
+t = json.load(open(sys.argv[1]))
+assert set(t) == {"movements", "phases", "high", "low"}, set(t)
+assert len(t["movements"]) == 12 and len(t["phases"]) == 8 and t["phases"][0] == "4+7"
+assert all(len(row) == 8 for row in t["high"] + t["low"]) and len(t["high"]) == len(t["low"]) == 12
+same = sum(h == l for hr, lr in zip(t["high"], t["low"]) for h, l in zip(hr, lr))
+assert same * 8 == 96, same
+assert t["low"][t["movements"].index("N->S")][t["phases"].index("3+8")] == "4+8"
+PY
+then pass; else fail "preemption tables --json"; fi
+"$corridor" preemption tables | grep -q "agree in 12 of 96 cells" && pass || fail "preemption tables text"
+
 echo "$passed passed, $failed failed"
 ((failed == 0))

@@ -1,0 +1,95 @@
+// Reads a SUMO .net.xml (edges, junctions with their right-of-way requests, connections and
+// traffic-light programs) and turns each traffic light into a SignalPlan whose movements are SUMO's
+// link indices, so that SUMO runs and the preemption engine share ids.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "maps/geo.hpp"
+#include "maps/signal_plan.hpp"
+
+namespace corridor::maps {
+
+struct SumoLane {
+  std::string id;
+  double length_m = 0;
+  double speed_mps = 0;
+  std::vector<Point2> shape;  // SUMO's network coordinates
+};
+
+struct SumoEdge {
+  std::string id;
+  std::string from;
+  std::string to;
+  std::string function;  // "internal" for junction-internal edges
+  std::vector<SumoLane> lanes;
+};
+
+struct SumoRequest {
+  std::string foes;      // one char per junction link; the last char is link 0
+  std::string response;  // same layout: links this one must yield to
+};
+
+struct SumoJunction {
+  std::string id;
+  std::string type;
+  Point2 position;
+  std::vector<SumoRequest> requests;  // by junction link index
+};
+
+struct SumoConnection {
+  std::string from;
+  std::string to;
+  int from_lane = 0;
+  int to_lane = 0;
+  std::string via;  // first internal lane, ":<junction>_<link>_<lane>"
+  std::string tl;
+  int link_index = -1;
+  char dir = 's';
+};
+
+struct SumoTlPhase {
+  double duration_s = 0;
+  std::string state;
+  double min_duration_s = 0;
+};
+
+struct SumoTlLogic {
+  std::string id;
+  std::string program_id;
+  std::string type;
+  std::vector<SumoTlPhase> phases;
+};
+
+struct SumoNet {
+  std::vector<SumoEdge> edges;
+  std::vector<SumoJunction> junctions;
+  std::vector<SumoConnection> connections;
+  std::vector<SumoTlLogic> tl_logics;
+  Point2 net_offset;
+  std::string proj_parameter;
+
+  [[nodiscard]] const SumoEdge* edge(const std::string& id) const;
+  [[nodiscard]] const SumoJunction* junction(const std::string& id) const;
+};
+
+// Throws MapLoadError for a missing file or malformed XML, naming the file and line.
+SumoNet read_sumo_net(const std::filesystem::path& file);
+
+// One traffic light's plan. plan.movements[i] is SUMO link i of the program (state[i]).
+struct SumoSignalPlan {
+  std::string tls_id;
+  std::string program_id;
+  SignalPlan plan;
+  std::vector<const SumoConnection*> links;  // by link index; null where no connection names it
+};
+
+// Conflicts come from the junction requests (foes) of links at the same junction; links at
+// different junctions of a joined traffic light never conflict. Phases are SUMO's phases with a
+// green ('G' or 'g'); yellow_s is the longest yellow phase and all_red_s the longest all-red one,
+// at least `min_all_red_s`. Throws MapLoadError when a program's states do not match its links.
+std::vector<SumoSignalPlan> sumo_signal_plans(const SumoNet& net, double min_all_red_s = 1.0);
+
+}  // namespace corridor::maps

@@ -1,0 +1,128 @@
+#include "maps/sumo_net.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "maps/errors.hpp"
+#include "preemption/phase_selection.hpp"
+
+namespace corridor::maps {
+namespace {
+
+// Built by the CTest fixture with netconvert from ../shared/data/osm/monaco.osm.gz.
+const SumoNet& monaco() {
+  static const SumoNet net = read_sumo_net(CORRIDOR_MONACO_NET);
+  return net;
+}
+
+TEST(SumoNet, ReadsEdgesJunctionsConnectionsAndTrafficLights) {
+  const SumoNet& net = monaco();
+  EXPECT_GT(net.edges.size(), 500u);
+  EXPECT_GT(net.junctions.size(), 200u);
+  EXPECT_GT(net.connections.size(), 500u);
+  ASSERT_GE(net.tl_logics.size(), 3u);
+  for (const auto& logic : net.tl_logics) {
+    EXPECT_FALSE(logic.phases.empty()) << logic.id;
+    for (const auto& p : logic.phases) {
+      EXPECT_GT(p.duration_s, 0.0);
+      EXPECT_EQ(p.state.size(), logic.phases.front().state.size());
+    }
+  }
+  const SumoJunction* j = net.junction(net.tl_logics.front().id);
+  ASSERT_NE(j, nullptr);
+  EXPECT_EQ(j->type, "traffic_light");
+  EXPECT_FALSE(j->requests.empty());
+  for (const auto& e : net.edges) {
+    for (const auto& lane : e.lanes) {
+      ASSERT_GE(lane.shape.size(), 2u) << lane.id;
+      ASSERT_GT(lane.length_m, 0.0) << lane.id;
+    }
+  }
+}
+
+TEST(SumoNet, EveryLinkOfEveryProgramHasItsConnection) {
+  const auto plans = sumo_signal_plans(monaco());
+  ASSERT_EQ(plans.size(), monaco().tl_logics.size());
+  for (const auto& sp : plans) {
+    ASSERT_EQ(sp.links.size(), sp.plan.movements.size());
+    for (std::size_t i = 0; i < sp.links.size(); ++i) {
+      ASSERT_NE(sp.links[i], nullptr) << sp.tls_id << " link " << i;
+      EXPECT_EQ(sp.links[i]->link_index, static_cast<int>(i));
+      EXPECT_EQ(sp.links[i]->tl, sp.tls_id);
+      EXPECT_FALSE(sp.links[i]->via.empty());
+    }
+    EXPECT_FALSE(sp.plan.program.empty());
+    EXPECT_GT(sp.plan.yellow_s, 0.0);
+  }
+}
+
+// The parsed conflict relation against SUMO's own programs: links SUMO shows with priority green
+// ('G') together must never be foes. A wrong link mapping or bit order breaks this.
+TEST(SumoNet, PriorityGreensOfSumoPhasesNeverConflict) {
+  std::size_t pairs_checked = 0, conflicts_found = 0;
+  for (const auto& sp : sumo_signal_plans(monaco())) {
+    const std::size_t n = sp.plan.movements.size();
+    for (std::size_t a = 0; a < n; ++a) {
+      EXPECT_FALSE(sp.plan.conflicts(a, a));
+      for (std::size_t b = 0; b < n; ++b) {
+        EXPECT_EQ(sp.plan.conflicts(a, b), sp.plan.conflicts(b, a));
+        conflicts_found += sp.plan.conflicts(a, b) ? 1 : 0;
+      }
+    }
+    for (const auto& logic : monaco().tl_logics) {
+      if (logic.id != sp.tls_id) continue;
+      for (const auto& phase : logic.phases) {
+        for (std::size_t a = 0; a < n; ++a) {
+          for (std::size_t b = a + 1; b < n; ++b) {
+            if (phase.state[a] == 'G' && phase.state[b] == 'G') {
+              ++pairs_checked;
+              EXPECT_FALSE(sp.plan.conflicts(a, b)) << sp.tls_id << " " << phase.state << " links " << a << "," << b;
+            }
+          }
+        }
+      }
+    }
+  }
+  EXPECT_GT(pairs_checked, 20u);
+  EXPECT_GT(conflicts_found, 20u);  // the relation is not empty either
+}
+
+// For every link of every Monaco signal, preemption finds a phase that serves it and is safe
+// under the strict conflict relation (SUMO's permissive 'g' phases are not, so some are built).
+TEST(SumoNet, PreemptionPhaseForEveryLinkIsSafe) {
+  std::size_t synthesized = 0, decisions = 0;
+  for (const auto& sp : sumo_signal_plans(monaco())) {
+    for (std::size_t link = 0; link < sp.plan.movements.size(); ++link) {
+      for (auto level : {preemption::CongestionLevel::low, preemption::CongestionLevel::high}) {
+        for (std::size_t current = 0; current < sp.plan.phases.size(); ++current) {
+          const auto d = preemption::select_phase(sp.plan, link, current, level);
+          ++decisions;
+          EXPECT_TRUE(d.phase.serves(link));
+          EXPECT_TRUE(sp.plan.phase_is_safe(d.phase)) << sp.tls_id << " link " << link;
+          synthesized += d.index ? 0 : 1;
+        }
+      }
+    }
+  }
+  EXPECT_GT(decisions, 50u);
+  std::cout << decisions << " decisions, " << synthesized << " synthesized phases\n";
+}
+
+TEST(SumoNet, BadFilesAreClearErrors) {
+  EXPECT_THROW((void)read_sumo_net("/no/such/net.net.xml"), MapLoadError);
+  const auto path = std::filesystem::temp_directory_path() / "corridor-broken.net.xml";
+  std::ofstream(path) << "<net>\n<edge id=\"a\">\n<lane id=\"a_0\" shape=\"0,0 1,1\"/>\n</net>\n";
+  try {
+    (void)read_sumo_net(path);
+    FAIL();
+  } catch (const MapLoadError& e) {
+    EXPECT_NE(std::string(e.what()).find("line"), std::string::npos) << e.what();
+  }
+  std::ofstream(path) << "<osm version=\"0.6\"></osm>\n";
+  EXPECT_THROW((void)read_sumo_net(path), MapLoadError);
+  std::filesystem::remove(path);
+}
+
+}  // namespace
+}  // namespace corridor::maps
