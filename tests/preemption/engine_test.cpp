@@ -7,6 +7,7 @@
 #include "maps/graph_builder.hpp"
 #include "maps/intersection_geometry.hpp"
 #include "maps/synthetic_grid.hpp"
+#include "planner/dstar_lite.hpp"
 #include "planner/one_to_one_search.hpp"
 #include "preemption/safety_monitor.hpp"
 #include "preemption/simulated_signal_controller.hpp"
@@ -195,6 +196,64 @@ TEST(PreemptionEngine, QueueOnTheApproachStartsEarlierWithTheWholeApproach) {
   // so the start is as soon as possible: now.
   EXPECT_DOUBLE_EQ(s.start_s, 10.0);
   EXPECT_THROW(rig.engine.record_counts(rig.c, maps::Compass::east, 5.0, 1.0, 0.0), CountError);
+}
+
+// The schedule follows D* Lite: after congestion moves the route, intersections no longer crossed
+// are cancelled, new ones are scheduled, and every arrival matches the planner's ETA.
+TEST(PreemptionEngine, FollowsDStarLiteReplans) {
+  maps::GridSpec spec;
+  spec.rows = 9;
+  spec.cols = 9;
+  spec.seed = 5;
+  spec.signal_fraction = 1.0;
+  spec.oneway_fraction = 0.0;
+  const maps::RoadGraph g = maps::make_perturbed_grid(spec);
+  const auto plans = maps::default_signal_plans(g);
+  SimulatedSignalController controller(plans, 0.0);
+  PreemptionEngine engine(g, plans, controller);
+  planner::CostOverlay overlay(g);
+  const planner::TravelCost cost(g, overlay, {15.0});
+  const EdgeId first{0}, last{static_cast<std::uint32_t>(g.edge_count() - 1)};
+  planner::DStarLite dstar(cost, {{first, 0.0}}, {{last, g.length_m(last)}});
+  dstar.replan();
+  planner::Route route = dstar.route();
+  auto crossings = signalized_crossings(route, plans, 0.0);
+  ASSERT_GE(crossings.size(), 4u);
+  engine.update_route(1, 1, crossings, 0.0);
+  EXPECT_EQ(engine.schedule(1).size(), crossings.size());
+
+  // Congestion on the middle of the route: D* Lite goes around it.
+  std::vector<EdgeId> changed;
+  for (std::size_t i = route.edges.size() / 3; i < 2 * route.edges.size() / 3; ++i) {
+    overlay.set_edge(route.edges[i], {40.0, 0.0});
+    changed.push_back(route.edges[i]);
+  }
+  dstar.edges_changed(changed);
+  dstar.replan();
+  const planner::Route rerouted = dstar.route();
+  ASSERT_NE(rerouted.edges, route.edges);
+  const double now = 2.0;
+  crossings = signalized_crossings(rerouted, plans, now);
+  engine.update_route(1, 1, crossings, now);
+
+  std::size_t live = 0, cancelled = 0;
+  for (const ScheduleEntry& e : engine.schedule(1)) {
+    const bool on_route = std::any_of(crossings.begin(), crossings.end(), [&](const Crossing& c) { return c.node == e.node; });
+    if (e.state == EntryState::cancelled) {
+      ++cancelled;
+      EXPECT_FALSE(on_route);
+    } else {
+      ++live;
+      ASSERT_TRUE(on_route);
+      const auto c = std::find_if(crossings.begin(), crossings.end(), [&](const Crossing& x) { return x.node == e.node; });
+      EXPECT_DOUBLE_EQ(e.arrival_s, c->arrival_s);
+      const auto i = std::find(rerouted.nodes.begin(), rerouted.nodes.end(), e.node) - rerouted.nodes.begin();
+      EXPECT_DOUBLE_EQ(e.arrival_s, now + rerouted.arrival_s[static_cast<std::size_t>(i)]);  // the planner's ETA
+      EXPECT_LE(e.start_s, e.arrival_s);
+    }
+  }
+  EXPECT_EQ(live, crossings.size());
+  EXPECT_GT(cancelled, 0u);
 }
 
 // Property test: many random missions with planner routes over a grid of signalized junctions,
