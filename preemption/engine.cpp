@@ -89,12 +89,21 @@ bool PreemptionEngine::time_entry(ScheduleEntry& e, const Crossing& c, double no
   const QueueEstimator* queue = nullptr;
   if (auto it = queues_.find(c.node); it != queues_.end() && it->second.has_data(from)) queue = &it->second;
   ApproachMeasurement measured;
+  if (auto it = measurements_.find(c.node); it != measurements_.end()) measured = it->second[static_cast<int>(from)];
   if (queue != nullptr) measured.queue_veh = queue->queue_now(from);
   e.congestion = classify_congestion(measured, config_.congestion);
+  // Measured demand per movement (the queue on its approach) where detectors report it.
+  std::vector<double> demand(plan.movements.size(), std::nan(""));
+  if (auto it = queues_.find(c.node); it != queues_.end()) {
+    for (std::size_t m = 0; m < plan.movements.size(); ++m) {
+      if (it->second.has_data(plan.movements[m].from)) demand[m] = it->second.queue_now(plan.movements[m].from);
+    }
+  }
 
   // An active hold keeps its phase unless the vehicle's movement changed.
   const bool keep = e.state == EntryState::active && e.phase.serves(e.movement);
-  const PhaseDecision decision = select_phase(plan, e.movement, controller_.current_phase(c.node), e.congestion);
+  const PhaseDecision decision =
+      select_phase(plan, e.movement, controller_.current_phase(c.node), e.congestion, demand);
   if (!keep) e.phase = decision.phase;
 
   // Gedawy: p = τ − Trans − margin (− t_q(τ) under congestion).
@@ -296,6 +305,18 @@ void PreemptionEngine::record_counts(NodeId node, maps::Compass approach, double
                                      double departures) {
   if (plans_.count(node) == 0) throw CountError("node " + std::to_string(node.v) + " has no signal");
   queues_[node].record(approach, time_s, arrivals, departures);
+}
+
+void PreemptionEngine::record_measurement(NodeId node, maps::Compass approach, std::optional<double> occupancy,
+                                          std::optional<double> speed_ratio) {
+  if (plans_.count(node) == 0) throw CountError("node " + std::to_string(node.v) + " has no signal");
+  if (occupancy && !(*occupancy >= 0.0 && *occupancy <= 1.0)) throw CountError("occupancy must be within [0, 1]");
+  if (speed_ratio && !(*speed_ratio >= 0.0 && std::isfinite(*speed_ratio))) {
+    throw CountError("speed ratio must be a finite number >= 0");
+  }
+  ApproachMeasurement& m = measurements_[node][static_cast<int>(approach)];
+  m.occupancy = occupancy;
+  m.speed_ratio = speed_ratio;
 }
 
 void PreemptionEngine::tick(double now_s) {

@@ -3,7 +3,9 @@
 // SignalController, and restores the normal program behind the vehicle. Time is the caller's.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <optional>
 #include <map>
 #include <memory>
 #include <span>
@@ -85,6 +87,10 @@ class PreemptionEngine {
   void cancel(MissionId mission, double now_s);
   // Detector counts for the queue estimate. Throws CountError for bad counts.
   void record_counts(NodeId node, maps::Compass approach, double time_s, double arrivals, double departures);
+  // Occupancy (0..1) or measured/free speed ratio of an approach, for the congestion classifier
+  // where no queue estimate exists. Throws CountError for values outside their range.
+  void record_measurement(NodeId node, maps::Compass approach, std::optional<double> occupancy,
+                          std::optional<double> speed_ratio);
   // Starts holds whose time has come, expires overdue ones, and releases signals no one holds.
   void tick(double now_s);
 
@@ -114,6 +120,7 @@ class PreemptionEngine {
   std::map<MissionId, std::vector<std::unique_ptr<ScheduleEntry>>> missions_;
   std::unordered_map<NodeId, NodeState> nodes_;
   std::unordered_map<NodeId, QueueEstimator> queues_;
+  std::unordered_map<NodeId, std::array<ApproachMeasurement, 4>> measurements_;
   std::vector<PreemptionEvent> events_;
 };
 

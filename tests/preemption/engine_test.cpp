@@ -256,6 +256,21 @@ TEST(PreemptionEngine, FollowsDStarLiteReplans) {
   EXPECT_GT(cancelled, 0u);
 }
 
+TEST(PreemptionEngine, OccupancyOrSpeedRatioClassifyCongestionWithoutQueueData) {
+  Rig rig;
+  rig.engine.record_measurement(rig.c, maps::Compass::south, 0.45, std::nullopt);
+  rig.engine.record_measurement(rig.c, maps::Compass::west, std::nullopt, 0.9);
+  const std::vector<Crossing> south{rig.crossing(kS, kN, 50.0)};
+  const std::vector<Crossing> west{rig.crossing(kW, kE, 50.0)};
+  rig.engine.update_route(1, 1, south, 0.0);
+  rig.engine.update_route(2, 1, west, 0.0);
+  EXPECT_EQ(rig.engine.schedule(1)[0].congestion, CongestionLevel::high);
+  EXPECT_EQ(rig.engine.schedule(1)[0].phase.label, "3+8");  // the whole South approach
+  EXPECT_EQ(rig.engine.schedule(2)[0].congestion, CongestionLevel::low);
+  EXPECT_THROW(rig.engine.record_measurement(rig.c, maps::Compass::west, 1.5, std::nullopt), CountError);
+  EXPECT_THROW(rig.engine.record_measurement(NodeId{99}, maps::Compass::west, 0.1, std::nullopt), CountError);
+}
+
 // Property test: many random missions with planner routes over a grid of signalized junctions,
 // random arrivals (some vehicles never come), reroutes and cancels. No safety violation ever, and
 // every junction is back in its normal program within a bounded time once the missions are over.
