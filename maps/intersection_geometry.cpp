@@ -5,26 +5,18 @@
 namespace corridor::maps {
 namespace {
 
-// Sectors of 90° centred on the compass directions; y is north, x is east.
-Compass side_of(Point2 from_node, Point2 toward) {
-  const double angle = std::atan2(toward.y_m - from_node.y_m, toward.x_m - from_node.x_m) * 180.0 / M_PI;
-  if (angle >= 45.0 && angle < 135.0) return Compass::north;
-  if (angle >= -45.0 && angle < 45.0) return Compass::east;
-  if (angle >= -135.0 && angle < -45.0) return Compass::south;
-  return Compass::west;
-}
 
 }  // namespace
 
 Compass approach_side(const RoadGraph& graph, EdgeId in_edge) {
   const auto pts = graph.geometry(in_edge);
   // The last bend before the node tells the side; the far end may curve away.
-  return side_of(pts.back(), pts[pts.size() - 2]);
+  return compass_side(pts.back(), pts[pts.size() - 2]);
 }
 
 Compass exit_side(const RoadGraph& graph, EdgeId out_edge) {
   const auto pts = graph.geometry(out_edge);
-  return side_of(pts.front(), pts[1]);
+  return compass_side(pts.front(), pts[1]);
 }
 
 std::uint8_t legs_of(const RoadGraph& graph, NodeId node) {

@@ -1,6 +1,7 @@
 #include "maps/signal_plan.hpp"
 
 #include <array>
+#include <cmath>
 
 namespace corridor::maps {
 namespace {
@@ -31,6 +32,14 @@ bool nema_compatible(int a, int b) {
 }  // namespace
 
 char compass_letter(Compass c) { return "NESW"[static_cast<int>(c)]; }
+
+Compass compass_side(Point2 center, Point2 toward) {
+  const double angle = std::atan2(toward.y_m - center.y_m, toward.x_m - center.x_m) * 180.0 / M_PI;
+  if (angle >= 45.0 && angle < 135.0) return Compass::north;
+  if (angle >= -45.0 && angle < 45.0) return Compass::east;
+  if (angle >= -135.0 && angle < -45.0) return Compass::south;
+  return Compass::west;
+}
 
 std::string Movement::label() const { return std::string{compass_letter(from)} + "->" + compass_letter(to); }
 

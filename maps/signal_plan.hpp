@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "maps/geo.hpp"
 #include "maps/ids.hpp"
 
 namespace corridor::maps {
@@ -15,6 +16,10 @@ enum class Compass : std::uint8_t { north, east, south, west };
 enum class Turn : std::uint8_t { through, right, left };
 
 char compass_letter(Compass c);
+
+// The compass sector (90° wide, centred on N, E, S, W) of `toward` seen from `center`, in a frame
+// whose y axis points north.
+Compass compass_side(Point2 center, Point2 toward);
 
 struct Movement {
   Compass from = Compass::north;  // the approach the traffic comes from

@@ -114,13 +114,6 @@ bool bit(const std::string& bits, std::size_t link) {
   return link < bits.size() && bits[bits.size() - 1 - link] == '1';
 }
 
-Compass side_of(Point2 center, Point2 toward) {
-  const double angle = std::atan2(toward.y_m - center.y_m, toward.x_m - center.x_m) * 180.0 / M_PI;
-  if (angle >= 45.0 && angle < 135.0) return Compass::north;
-  if (angle >= -45.0 && angle < 45.0) return Compass::east;
-  if (angle >= -135.0 && angle < -45.0) return Compass::south;
-  return Compass::west;
-}
 
 Turn turn_of(char dir) {
   switch (dir) {
@@ -209,8 +202,8 @@ std::vector<SumoSignalPlan> sumo_signal_plans(const SumoNet& net, double min_all
       Movement& m = plan.movements[i];
       const auto& in_shape = from->second->lanes.empty() ? std::vector<Point2>{} : from->second->lanes.front().shape;
       const auto& out_shape = to->second->lanes.empty() ? std::vector<Point2>{} : to->second->lanes.front().shape;
-      if (in_shape.size() >= 2) m.from = side_of(center, in_shape[in_shape.size() - 2]);
-      if (out_shape.size() >= 2) m.to = side_of(center, out_shape[1]);
+      if (in_shape.size() >= 2) m.from = compass_side(center, in_shape[in_shape.size() - 2]);
+      if (out_shape.size() >= 2) m.to = compass_side(center, out_shape[1]);
       m.turn = turn_of(c->dir);
     }
     plan.conflict.assign(n * n, 0);

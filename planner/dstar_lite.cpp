@@ -140,11 +140,7 @@ std::string DStarLite::invariant_violation() const {
 Route DStarLite::route() const {
   const Vertex start = space_.start();
   const Vertex goal = space_.goal();
-  Route none;
-  none.start = space_.starts().front();
-  none.goal = space_.goals().front();
-  if (g_[start.index()] >= kInfCost && rhs_[start.index()] >= kInfCost) return none;
-
+  if (rhs_[start.index()] >= kInfCost) return space_.route_along({});
   std::vector<EdgeId> edges;
   Vertex u = start;
   // Every arc costs more than zero except S arcs, so a path has at most vertex_count arcs.
@@ -160,20 +156,11 @@ Route DStarLite::route() const {
         via = e;
       }
     });
-    if (!next.valid()) return none;
+    if (!next.valid()) return space_.route_along({});
     edges.push_back(via);
     u = next;
   }
-  if (u != goal) return none;
-  EdgePoint s = space_.starts().front();
-  for (const EdgePoint& p : space_.starts()) {
-    if (p.edge == edges.front()) s = p;
-  }
-  EdgePoint t = space_.goals().front();
-  for (const EdgePoint& p : space_.goals()) {
-    if (p.edge == edges.back()) t = p;
-  }
-  return make_route(space_.cost(), s, std::move(edges), t);
+  return space_.route_along(u == goal ? std::move(edges) : std::vector<EdgeId>{});
 }
 
 }  // namespace corridor::planner

@@ -74,28 +74,12 @@ Route OneToOneSearch::run(const SearchSpace& space, bool use_heuristic, SearchSt
   }
   if (stats != nullptr) *stats = local;
 
-  Route none;
-  none.start = space.starts().front();
-  none.goal = space.goals().front();
-  if (!reached || dist(t) >= kInfCost) return none;
-
+  if (!reached || dist(t) >= kInfCost) return space.route_along({});
   // Walk back G -> S. The first arc's via is the start edge, the last arc's via is the goal edge.
   std::vector<EdgeId> edges;
   for (Vertex v = t; v != s; v = Vertex{parent_[v.index()]}) edges.push_back(parent_edge_[v.index()]);
   std::reverse(edges.begin(), edges.end());
-  // Edges of arcs into graph nodes are driven whole, except the start edge (first) and the goal
-  // edge (last); for a direct S->G arc, the one edge is both.
-  EdgePoint start = space.starts().front();
-  for (const EdgePoint& p : space.starts()) {
-    if (p.edge == edges.front()) start = p;
-  }
-  EdgePoint goal = space.goals().front();
-  for (const EdgePoint& p : space.goals()) {
-    if (p.edge == edges.back()) goal = p;
-  }
-  // The G arc repeats the goal edge as its via: a route whose last driven edge leads into the
-  // goal edge's tail lists the goal edge once, as the last element.
-  return make_route(space.cost(), start, std::move(edges), goal);
+  return space.route_along(std::move(edges));
 }
 
 }  // namespace corridor::planner

@@ -21,6 +21,24 @@ void SearchSpace::set_starts(std::vector<EdgePoint> starts) {
   start_pos_ = cost_->graph().point_along(starts_.front().edge, starts_.front().offset_m);
 }
 
+Route SearchSpace::route_along(std::vector<EdgeId> edges) const {
+  EdgePoint start = starts_.front();
+  EdgePoint goal = goals_.front();
+  if (edges.empty()) {
+    Route none;
+    none.start = start;
+    none.goal = goal;
+    return none;
+  }
+  for (const EdgePoint& p : starts_) {
+    if (p.edge == edges.front()) start = p;
+  }
+  for (const EdgePoint& p : goals_) {
+    if (p.edge == edges.back()) goal = p;
+  }
+  return make_route(*cost_, start, std::move(edges), goal);
+}
+
 bool SearchSpace::is_start_edge(EdgeId e) const {
   for (const EdgePoint& s : starts_) {
     if (s.edge == e) return true;

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "maps/ids.hpp"
+#include "planner/route.hpp"
 #include "planner/travel_cost.hpp"
 
 namespace corridor::planner {
@@ -80,6 +81,10 @@ class SearchSpace {
       if (g.head(s.edge) == n) f(start(), cost_->partial_time_s(s.edge, s.offset_m, g.length_m(s.edge)));
     }
   }
+
+  // The route driving `edges` (the via edges of a path of arcs from S to G), between the start and
+  // goal points on its first and last edge.
+  [[nodiscard]] Route route_along(std::vector<EdgeId> edges) const;
 
   // True when a change of this edge's cost changes an arc out of S.
   [[nodiscard]] bool is_start_edge(EdgeId e) const;
