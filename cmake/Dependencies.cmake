@@ -8,6 +8,7 @@ find_package(CLI11 REQUIRED)
 find_package(nlohmann_json 3.10 REQUIRED)
 find_package(spdlog REQUIRED)
 find_package(fmt REQUIRED)
+find_package(SQLite3 REQUIRED)
 
 # Debian ships GeographicLib without a CMake config; find the library and header directly.
 find_library(GEOGRAPHICLIB_LIBRARY NAMES GeographicLib REQUIRED)

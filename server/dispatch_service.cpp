@@ -1,0 +1,490 @@
+#include "server/dispatch_service.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+
+#include "maps/errors.hpp"
+#include "maps/intersection_geometry.hpp"
+#include "planner/route_geojson.hpp"
+
+namespace corridor::server {
+
+const char* to_string(MissionState s) {
+  switch (s) {
+    case MissionState::active: return "active";
+    case MissionState::completed: return "completed";
+    case MissionState::cancelled: return "cancelled";
+  }
+  return "?";
+}
+
+std::optional<MissionState> mission_state_from(const std::string& s) {
+  for (MissionState m : {MissionState::active, MissionState::completed, MissionState::cancelled}) {
+    if (s == to_string(m)) return m;
+  }
+  return std::nullopt;
+}
+
+struct DispatchService::Mission {
+  MissionRow row;
+  std::optional<maps::LatLon> last_position;
+  maps::Point2 destination_local;
+  std::unique_ptr<planner::TravelCost> cost;
+  std::unique_ptr<planner::DStarLite> planner;
+  planner::Route route;
+  std::uint32_t revision = 0;
+};
+
+namespace {
+
+ApiError snap_error(const maps::SnapError& e, const char* what) {
+  const char* code = e.reason() == maps::SnapError::Reason::invalid_coordinate ? "invalid_coordinate"
+                     : e.reason() == maps::SnapError::Reason::outside_map  ? "outside_map"
+                                                                            : "off_road";
+  return unprocessable(code, std::string(what) + ": " + e.what());
+}
+
+// Compass bearing of edge e around offset, degrees clockwise from north.
+double bearing_deg(const maps::RoadGraph& g, EdgeId e, double offset_m) {
+  const double len = g.length_m(e);
+  const maps::Point2 a = g.point_along(e, std::max(0.0, offset_m - 1.0));
+  const maps::Point2 b = g.point_along(e, std::min(len, offset_m + 1.0));
+  return std::fmod(std::atan2(b.x_m - a.x_m, b.y_m - a.y_m) * 180.0 / M_PI + 360.0, 360.0);
+}
+
+double angle_between_deg(double a, double b) {
+  const double d = std::fmod(std::abs(a - b), 360.0);
+  return d > 180.0 ? 360.0 - d : d;
+}
+
+}  // namespace
+
+DispatchService::DispatchService(const maps::RoadGraph& graph, DispatchConfig config, Store* store, double now_s)
+    : graph_(graph),
+      config_(config),
+      store_(store),
+      snapper_(graph),
+      overlay_(graph),
+      plans_(maps::default_signal_plans(graph)),
+      signals_(plans_, now_s),
+      preemption_(graph, plans_, signals_, config.preemption) {
+  overlay_.set_signal_delay(graph, config_.signal_delay_s);
+  for (EdgeId e : graph.edges()) edges_by_way_.emplace(graph.osm_way(e).v, e);
+  if (store_ != nullptr) restore(now_s);
+}
+
+DispatchService::~DispatchService() = default;
+
+void DispatchService::subscribe(Listener listener) {
+  std::lock_guard lock(mutex_);
+  listeners_.push_back(std::move(listener));
+}
+
+void DispatchService::emit(const std::string& kind, MissionId mission, const std::string& reason, double now_s) {
+  const DispatchEvent event{kind, mission, reason, now_s};
+  for (const auto& l : listeners_) l(event);
+}
+
+std::vector<planner::EdgePoint> DispatchService::endpoints(const maps::SnapResult& s, Role role,
+                                                           std::optional<double> heading) const {
+  std::vector<planner::EdgePoint> both{{s.edge, s.offset_m}};
+  if (s.twin.valid()) both.push_back({s.twin, s.twin_offset_m});
+  if (both.size() == 2) {
+    // At a node, the two directions are one place: keep the one without a zero-length stub, so a
+    // route never lists an edge it does not drive (a goal is the end of the edge arriving there,
+    // a start the beginning of the edge leaving it).
+    constexpr double kAtNodeM = 0.01;
+    for (std::size_t i = 0; i < 2; ++i) {
+      const double off = both[i].offset_m, len = graph_.length_m(both[i].edge);
+      const bool stub = role == Role::goal ? off <= kAtNodeM : off >= len - kAtNodeM;
+      if (stub) return {both[1 - i]};
+    }
+  }
+  if (!heading || both.size() == 1) return both;
+  // A heading picks the direction of travel on a two-way street.
+  const double a = angle_between_deg(bearing_deg(graph_, both[0].edge, both[0].offset_m), *heading);
+  const double b = angle_between_deg(bearing_deg(graph_, both[1].edge, both[1].offset_m), *heading);
+  return {a <= b ? both[0] : both[1]};
+}
+
+MissionView DispatchService::view(const Mission& m) const {
+  MissionView v;
+  v.id = m.row.id;
+  v.vehicle_id = m.row.vehicle_id;
+  v.state = m.row.state;
+  v.priority = m.row.priority;
+  v.vmax_kmh = m.row.vmax_kmh;
+  v.destination = m.row.destination;
+  v.last_position = m.last_position;
+  v.route = m.route;
+  v.route_revision = m.revision;
+  v.schedule = preemption_.schedule(m.row.id);
+  v.created_s = m.row.created_s;
+  v.updated_s = m.row.updated_s;
+  return v;
+}
+
+void DispatchService::drain_preemption_events() {
+  for (const auto& e : preemption_.take_events()) {
+    if (store_ != nullptr) store_->insert_preemption_event(e);
+    emit("preemption_" + e.kind, e.mission, e.detail, e.time_s);
+  }
+}
+
+void DispatchService::publish_route(Mission& m, const std::string& reason, double now_s) {
+  ++m.revision;
+  m.row.updated_s = now_s;
+  if (store_ != nullptr) {
+    const auto feature = planner::route_to_geojson(graph_, m.route, "dstar");
+    store_->insert_route_revision(m.row.id, m.revision, reason, m.route.travel_time_s, m.route.length_m,
+                                  feature["geometry"].dump(), now_s);
+  }
+  const auto crossings = preemption::signalized_crossings(m.route, plans_, now_s);
+  preemption_.update_route(m.row.id, m.row.priority, crossings, now_s);
+  emit(m.revision == 1 ? "mission_created" : "route_changed", m.row.id, reason, now_s);
+  drain_preemption_events();
+}
+
+MissionView DispatchService::create_mission(const MissionRequest& req, double now_s) {
+  if (req.vehicle_id.empty() || req.vehicle_id.size() > 64) throw bad_request("vehicle_id must be 1 to 64 characters");
+  if (!(req.vmax_kmh >= 5.0 && req.vmax_kmh <= 250.0)) throw bad_request("vmax_kmh must be between 5 and 250");
+  if (req.priority < 0 || req.priority > 10) throw bad_request("priority must be between 0 and 10");
+  std::lock_guard lock(mutex_);
+  if (active_by_vehicle_.count(req.vehicle_id) != 0) {
+    throw conflict("vehicle '" + req.vehicle_id + "' already has active mission " +
+                   std::to_string(active_by_vehicle_.at(req.vehicle_id)) + "; cancel it first");
+  }
+  std::optional<maps::LatLon> origin = req.origin;
+  if (!origin) {
+    if (auto it = last_position_.find(req.vehicle_id); it != last_position_.end()) origin = it->second;
+  }
+  if (!origin) {
+    throw unprocessable("no_origin", "vehicle '" + req.vehicle_id +
+                                         "' has no known position: post one to /v1/vehicles/{id}/position or give origin");
+  }
+  maps::SnapResult from, to;
+  try {
+    from = snapper_.snap(*origin, {config_.snap_max_distance_m});
+  } catch (const maps::SnapError& e) {
+    throw snap_error(e, "origin");
+  }
+  try {
+    to = snapper_.snap(req.destination, {config_.snap_max_distance_m});
+  } catch (const maps::SnapError& e) {
+    throw snap_error(e, "destination");
+  }
+
+  auto m = std::make_unique<Mission>();
+  m->row = {0, req.vehicle_id, req.priority, req.vmax_kmh, req.destination, origin, MissionState::active, now_s, now_s};
+  m->last_position = origin;
+  m->destination_local = to.point;
+  m->cost = std::make_unique<planner::TravelCost>(graph_, overlay_, planner::VehicleProfile{req.vmax_kmh / 3.6});
+  m->planner = std::make_unique<planner::DStarLite>(*m->cost, endpoints(from, Role::start, std::nullopt),
+                                                          endpoints(to, Role::goal, std::nullopt));
+  m->planner->replan();
+  m->route = m->planner->route();
+  if (!m->route.found) throw unprocessable("unreachable", "the destination cannot be reached from the origin");
+
+  if (store_ != nullptr) {
+    Store::Transaction tx(*store_);
+    m->row.id = store_->insert_mission(m->row);
+    Mission& ref = *m;
+    missions_[ref.row.id] = std::move(m);
+    active_by_vehicle_[ref.row.vehicle_id] = ref.row.id;
+    publish_route(ref, "dispatch", now_s);
+    tx.commit();
+    return view(ref);
+  }
+  m->row.id = next_memory_id_++;
+  Mission& ref = *m;
+  missions_[ref.row.id] = std::move(m);
+  active_by_vehicle_[ref.row.vehicle_id] = ref.row.id;
+  publish_route(ref, "dispatch", now_s);
+  return view(ref);
+}
+
+MissionView DispatchService::mission(MissionId id) const {
+  std::lock_guard lock(mutex_);
+  auto it = missions_.find(id);
+  if (it == missions_.end()) throw not_found("no mission " + std::to_string(id));
+  return view(*it->second);
+}
+
+std::vector<MissionView> DispatchService::missions(std::optional<MissionState> state) const {
+  std::lock_guard lock(mutex_);
+  std::vector<MissionView> out;
+  for (const auto& [id, m] : missions_) {
+    if (!state || m->row.state == *state) out.push_back(view(*m));
+  }
+  return out;
+}
+
+DispatchService::Mission& DispatchService::active(MissionId id) {
+  auto it = missions_.find(id);
+  if (it == missions_.end()) throw not_found("no mission " + std::to_string(id));
+  if (it->second->row.state != MissionState::active) {
+    throw conflict("mission " + std::to_string(id) + " is already " + to_string(it->second->row.state));
+  }
+  return *it->second;
+}
+
+void DispatchService::finish(Mission& m, MissionState state, double now_s) {
+  m.row.state = state;
+  m.row.updated_s = now_s;
+  if (store_ != nullptr) store_->update_mission_state(m.row.id, state, now_s);
+  active_by_vehicle_.erase(m.row.vehicle_id);
+  preemption_.cancel(m.row.id, now_s);
+  m.planner.reset();  // a finished mission keeps its last route, not its search state
+  emit(state == MissionState::completed ? "mission_completed" : "mission_cancelled", m.row.id, "", now_s);
+  drain_preemption_events();
+}
+
+MissionView DispatchService::cancel_mission(MissionId id, double now_s) {
+  std::lock_guard lock(mutex_);
+  Mission& m = active(id);
+  std::optional<Store::Transaction> tx;
+  if (store_ != nullptr) tx.emplace(*store_);
+  finish(m, MissionState::cancelled, now_s);
+  if (tx) tx->commit();
+  return view(m);
+}
+
+PositionResult DispatchService::report_position(const PositionReport& p, double now_s) {
+  if (p.vehicle_id.empty() || p.vehicle_id.size() > 64) throw bad_request("vehicle id must be 1 to 64 characters");
+  if (p.source != "gps" && p.source != "vo") throw bad_request("source must be \"gps\" or \"vo\"");
+  if (p.heading_deg && !(std::isfinite(*p.heading_deg) && *p.heading_deg >= 0.0 && *p.heading_deg <= 360.0)) {
+    throw bad_request("heading_deg must be within [0, 360]");
+  }
+  if (p.speed_mps && !(std::isfinite(*p.speed_mps) && *p.speed_mps >= 0.0 && *p.speed_mps < 150.0)) {
+    throw bad_request("speed_mps must be within [0, 150)");
+  }
+  if (p.hdop && !(std::isfinite(*p.hdop) && *p.hdop >= 0.0)) throw bad_request("hdop must be a number >= 0");
+  if (!std::isfinite(p.timestamp_s)) throw bad_request("timestamp must be a finite number of seconds");
+  maps::SnapResult snap;
+  try {
+    snap = snapper_.snap(p.position, {config_.snap_max_distance_m});
+  } catch (const maps::SnapError& e) {
+    throw snap_error(e, "position");
+  }
+
+  std::lock_guard lock(mutex_);
+  PositionResult result;
+  result.snap_distance_m = snap.distance_m;
+  std::optional<Store::Transaction> tx;
+  if (store_ != nullptr) tx.emplace(*store_);
+  last_position_[p.vehicle_id] = p.position;
+  auto it = active_by_vehicle_.find(p.vehicle_id);
+  if (it == active_by_vehicle_.end()) {
+    if (store_ != nullptr) store_->insert_position(p, std::nullopt, now_s);
+    if (tx) tx->commit();
+    return result;
+  }
+  Mission& m = *missions_.at(it->second);
+  result.mission = m.row.id;
+  if (store_ != nullptr) store_->insert_position(p, m.row.id, now_s);
+  m.last_position = p.position;
+
+  // Signals behind the vehicle: every intersection of the old route before its current edge.
+  const auto points = endpoints(snap, Role::start, p.heading_deg);
+  const auto pos_in_route = std::find_if(m.route.edges.begin(), m.route.edges.end(), [&](EdgeId e) {
+    return std::any_of(points.begin(), points.end(), [&](const planner::EdgePoint& q) { return q.edge == e; });
+  });
+  if (pos_in_route != m.route.edges.end()) {
+    const auto passed = static_cast<std::size_t>(pos_in_route - m.route.edges.begin());
+    for (std::size_t i = 0; i < passed && i < m.route.nodes.size(); ++i) preemption_.vehicle_passed(m.row.id, m.route.nodes[i], now_s);
+  }
+
+  const std::vector<EdgeId> old_edges = m.route.edges;
+  m.planner->move_start(points);
+  m.planner->replan();
+  m.route = m.planner->route();
+  result.eta_s = m.route.travel_time_s;
+  emit("position", m.row.id, p.source, now_s);
+  if (!m.route.found || m.route.length_m <= config_.arrival_radius_m ||
+      maps::distance_m(snap.point, m.destination_local) <= config_.arrival_radius_m) {
+    result.completed = true;
+    finish(m, MissionState::completed, now_s);
+  } else {
+    // The route changed if it is not the rest of the old one from the vehicle's edge on.
+    const auto from = std::find(old_edges.begin(), old_edges.end(), m.route.edges.front());
+    result.route_changed = !std::equal(from, old_edges.end(), m.route.edges.begin(), m.route.edges.end());
+    if (result.route_changed) {
+      publish_route(m, "off_route", now_s);
+    } else {
+      preemption_.update_route(m.row.id, m.row.priority, preemption::signalized_crossings(m.route, plans_, now_s), now_s);
+      drain_preemption_events();
+    }
+  }
+  if (tx) tx->commit();
+  return result;
+}
+
+std::vector<EdgeId> DispatchService::resolve_edges(const CongestionUpdate& u) const {
+  if (u.edge.has_value() == u.osm_way_id.has_value()) throw bad_request("each update needs exactly one of edge, osm_way_id");
+  if (u.edge) {
+    if (!u.edge->valid() || u.edge->index() >= graph_.edge_count()) {
+      throw unprocessable("unknown_edge", "edge " + std::to_string(u.edge->v) + " is not in the map (it has " +
+                                              std::to_string(graph_.edge_count()) + " edges)");
+    }
+    return {*u.edge};
+  }
+  std::vector<EdgeId> out;
+  auto [lo, hi] = edges_by_way_.equal_range(*u.osm_way_id);
+  for (auto it = lo; it != hi; ++it) out.push_back(it->second);
+  if (out.empty()) throw unprocessable("unknown_way", "OSM way " + std::to_string(*u.osm_way_id) + " is not in the map");
+  return out;
+}
+
+CongestionResult DispatchService::report_congestion(const std::vector<CongestionUpdate>& updates, double now_s) {
+  if (updates.empty()) throw bad_request("updates must hold at least one update");
+  if (updates.size() > 10000) throw bad_request("at most 10000 updates per request");
+  // Validate everything before changing anything: a request applies whole or not at all.
+  std::vector<std::pair<EdgeId, planner::EdgeCondition>> changes;
+  std::vector<std::optional<double>> expiry;
+  for (const CongestionUpdate& u : updates) {
+    const int given = (u.speed_kmh ? 1 : 0) + (u.travel_time_s ? 1 : 0) + (u.factor ? 1 : 0);
+    if (given != 1) throw bad_request("each update needs exactly one of speed_kmh, travel_time_s, factor");
+    if (u.expires_in_s && !(std::isfinite(*u.expires_in_s) && *u.expires_in_s > 0.0)) {
+      throw bad_request("expires_in_s must be a positive number of seconds");
+    }
+    if (u.speed_kmh && !(std::isfinite(*u.speed_kmh) && *u.speed_kmh >= 0.0 && *u.speed_kmh < 400.0)) {
+      throw bad_request("speed_kmh must be within [0, 400); 0 closes the road");
+    }
+    if (u.travel_time_s && !(std::isfinite(*u.travel_time_s) && *u.travel_time_s > 0.0)) {
+      throw bad_request("travel_time_s must be a positive number of seconds");
+    }
+    if (u.factor && !(*u.factor > 0.0) ) throw bad_request("factor must be positive (a very large factor closes the road)");
+    for (EdgeId e : resolve_edges(u)) {
+      const double free_flow_s = graph_.length_m(e) / graph_.speed_mps(e);
+      double factor = 1.0;
+      if (u.factor) factor = *u.factor;
+      if (u.speed_kmh) factor = *u.speed_kmh <= 0.0 ? planner::kInfCost : (graph_.speed_mps(e) * 3.6) / *u.speed_kmh;
+      // An osm_way_id update gives the time of the whole way; spread it by edge length.
+      if (u.travel_time_s) factor = *u.travel_time_s / free_flow_s;
+      changes.push_back({e, {factor, overlay_.edge(e).queue_delay_s}});
+      expiry.push_back(u.expires_in_s ? std::optional<double>(now_s + *u.expires_in_s) : std::nullopt);
+    }
+  }
+
+  std::lock_guard lock(mutex_);
+  std::optional<Store::Transaction> tx;
+  if (store_ != nullptr) tx.emplace(*store_);
+  std::vector<EdgeId> changed;
+  for (std::size_t i = 0; i < changes.size(); ++i) {
+    overlay_.set_edge(changes[i].first, changes[i].second);
+    changed.push_back(changes[i].first);
+    if (store_ != nullptr) store_->insert_congestion(changes[i].first, changes[i].second, expiry[i], now_s);
+    if (expiry[i]) expiries_.emplace(*expiry[i], changes[i].first);
+  }
+  CongestionResult result = replan_all(changed, "congestion", now_s);
+  emit("congestion_applied", 0, std::to_string(changed.size()) + " edges", now_s);
+  if (tx) tx->commit();
+  return result;
+}
+
+CongestionResult DispatchService::replan_all(const std::vector<EdgeId>& changed, const std::string& reason, double now_s) {
+  CongestionResult result;
+  result.edges_changed = changed.size();
+  for (auto& [id, m] : missions_) {
+    if (m->row.state != MissionState::active) continue;
+    const std::vector<EdgeId> before = m->route.edges;
+    m->planner->edges_changed(changed);
+    m->planner->replan();
+    m->route = m->planner->route();
+    ++result.missions_replanned;
+    if (m->route.edges != before) {
+      ++result.routes_changed;
+      publish_route(*m, reason, now_s);
+    } else {
+      // Same route, new costs: the arrival times moved, so the signals are re-timed.
+      preemption_.update_route(id, m->row.priority, preemption::signalized_crossings(m->route, plans_, now_s), now_s);
+      drain_preemption_events();
+    }
+  }
+  return result;
+}
+
+void DispatchService::report_counts(NodeId node, maps::Compass approach, double arrivals, double departures, double now_s) {
+  std::lock_guard lock(mutex_);
+  if (plans_.count(node) == 0) throw not_found("no signal at node " + std::to_string(node.v));
+  try {
+    preemption_.record_counts(node, approach, now_s, arrivals, departures);
+  } catch (const preemption::CountError& e) {
+    throw bad_request(e.what());
+  }
+}
+
+void DispatchService::tick(double now_s) {
+  std::lock_guard lock(mutex_);
+  std::vector<EdgeId> expired;
+  while (!expiries_.empty() && expiries_.begin()->first <= now_s) {
+    const EdgeId e = expiries_.begin()->second;
+    expiries_.erase(expiries_.begin());
+    // Only if no later update re-congested the edge with a later expiry or none.
+    bool superseded = false;
+    for (const auto& [t, edge] : expiries_) superseded = superseded || edge == e;
+    if (superseded) continue;
+    overlay_.reset_edge(e);
+    expired.push_back(e);
+  }
+  if (!expired.empty()) replan_all(expired, "congestion_expired", now_s);
+  signals_.advance(now_s);
+  preemption_.tick(now_s);
+  drain_preemption_events();
+}
+
+std::vector<preemption::Light> DispatchService::signal_lights(NodeId node) const {
+  std::lock_guard lock(mutex_);
+  if (plans_.count(node) == 0) throw not_found("no signal at node " + std::to_string(node.v));
+  return signals_.lights(node);
+}
+
+std::size_t DispatchService::active_mission_count() const {
+  std::lock_guard lock(mutex_);
+  return active_by_vehicle_.size();
+}
+
+void DispatchService::restore(double now_s) {
+  for (const CongestionRow& c : store_->congestion_in_force(now_s)) {
+    if (c.edge.index() >= graph_.edge_count()) continue;  // recorded against another map
+    overlay_.set_edge(c.edge, c.condition);
+    if (c.expires_at_s) expiries_.emplace(*c.expires_at_s, c.edge);
+  }
+  for (const MissionRow& row : store_->missions(std::nullopt)) {
+    const auto last = store_->last_position(row.vehicle_id);
+    if (row.state != MissionState::active) {
+      // Finished missions stay readable; they need no planner.
+      auto m = std::make_unique<Mission>();
+      m->row = row;
+      if (last) m->last_position = last->position;
+      missions_[row.id] = std::move(m);
+      continue;
+    }
+    const maps::LatLon start = last ? last->position : row.origin.value_or(row.destination);
+    try {
+      const auto from = snapper_.snap(start, {config_.snap_max_distance_m});
+      const auto to = snapper_.snap(row.destination, {config_.snap_max_distance_m});
+      auto m = std::make_unique<Mission>();
+      m->row = row;
+      m->last_position = start;
+      m->destination_local = to.point;
+      m->cost = std::make_unique<planner::TravelCost>(graph_, overlay_, planner::VehicleProfile{row.vmax_kmh / 3.6});
+      m->planner = std::make_unique<planner::DStarLite>(
+          *m->cost, endpoints(from, Role::start, last ? last->heading_deg : std::nullopt),
+          endpoints(to, Role::goal, std::nullopt));
+      m->planner->replan();
+      m->route = m->planner->route();
+      Mission& ref = *m;
+      missions_[row.id] = std::move(m);
+      active_by_vehicle_[row.vehicle_id] = row.id;
+      last_position_[row.vehicle_id] = start;
+      publish_route(ref, "restart", now_s);
+      spdlog::info("event=mission_resumed mission={} vehicle={}", row.id, row.vehicle_id);
+    } catch (const maps::SnapError& e) {
+      spdlog::error("event=mission_not_resumable mission={} reason=\"{}\"", row.id, e.what());
+    }
+  }
+}
+
+}  // namespace corridor::server

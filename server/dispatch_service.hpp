@@ -1,0 +1,91 @@
+// The dispatch service: the server's engine behind one facade. It owns the live congestion overlay,
+// one D* Lite planner per active mission, and the preemption engine; it persists every accepted
+// change before returning and rebuilds its state from the store on start-up. Transport-free, so
+// request handling can be tested and fuzzed without sockets.
+#pragma once
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <unordered_map>
+
+#include "maps/edge_snapper.hpp"
+#include "maps/road_graph.hpp"
+#include "planner/dstar_lite.hpp"
+#include "preemption/engine.hpp"
+#include "preemption/simulated_signal_controller.hpp"
+#include "server/api_error.hpp"
+#include "server/dispatch_types.hpp"
+#include "server/store.hpp"
+
+namespace corridor::server {
+
+struct DispatchConfig {
+  double snap_max_distance_m = 200.0;
+  double arrival_radius_m = 30.0;  // closer than this to the destination completes the mission
+  double signal_delay_s = 15.0;    // expected delay at a signalized intersection, for routing
+  preemption::PreemptionConfig preemption;
+};
+
+class DispatchService {
+ public:
+  using Listener = std::function<void(const DispatchEvent&)>;
+
+  // `store` may be null (nothing persisted). With a store, active missions and congestion in force
+  // are restored. Throws StoreError when the database cannot be read.
+  DispatchService(const maps::RoadGraph& graph, DispatchConfig config, Store* store, double now_s);
+  ~DispatchService();
+
+  // Every method validates its input and throws ApiError with a status and a clear message.
+  MissionView create_mission(const MissionRequest& request, double now_s);
+  [[nodiscard]] MissionView mission(MissionId id) const;
+  [[nodiscard]] std::vector<MissionView> missions(std::optional<MissionState> state) const;
+  MissionView cancel_mission(MissionId id, double now_s);
+  PositionResult report_position(const PositionReport& report, double now_s);
+  CongestionResult report_congestion(const std::vector<CongestionUpdate>& updates, double now_s);
+  void report_counts(NodeId node, maps::Compass approach, double arrivals, double departures, double now_s);
+  // Expires congestion and drives the signals; call about once a second.
+  void tick(double now_s);
+
+  void subscribe(Listener listener);
+  [[nodiscard]] const maps::RoadGraph& graph() const { return graph_; }
+  [[nodiscard]] const std::unordered_map<NodeId, maps::SignalPlan>& signal_plans() const { return plans_; }
+  [[nodiscard]] std::vector<preemption::Light> signal_lights(NodeId node) const;
+  [[nodiscard]] std::size_t active_mission_count() const;
+
+ private:
+  struct Mission;
+
+  Mission& active(MissionId id);
+  enum class Role { start, goal };
+  std::vector<planner::EdgePoint> endpoints(const maps::SnapResult& snap, Role role, std::optional<double> heading_deg) const;
+  void publish_route(Mission& m, const std::string& reason, double now_s);
+  // Repairs every active mission's plan after `changed` edges changed cost; publishes new routes.
+  CongestionResult replan_all(const std::vector<EdgeId>& changed, const std::string& reason, double now_s);
+  void drain_preemption_events();
+  void emit(const std::string& kind, MissionId mission, const std::string& reason, double now_s);
+  MissionView view(const Mission& m) const;
+  void finish(Mission& m, MissionState state, double now_s);
+  std::vector<EdgeId> resolve_edges(const CongestionUpdate& u) const;
+  void restore(double now_s);
+
+  const maps::RoadGraph& graph_;
+  DispatchConfig config_;
+  Store* store_;
+  maps::EdgeSnapper snapper_;
+  planner::CostOverlay overlay_;
+  std::unordered_map<NodeId, maps::SignalPlan> plans_;
+  preemption::SimulatedSignalController signals_;
+  preemption::PreemptionEngine preemption_;
+  std::unordered_multimap<std::int64_t, EdgeId> edges_by_way_;
+  std::map<MissionId, std::unique_ptr<Mission>> missions_;
+  std::unordered_map<std::string, MissionId> active_by_vehicle_;
+  std::unordered_map<std::string, maps::LatLon> last_position_;
+  std::multimap<double, EdgeId> expiries_;
+  std::vector<Listener> listeners_;
+  MissionId next_memory_id_ = 1;
+  mutable std::mutex mutex_;
+};
+
+}  // namespace corridor::server

@@ -1,0 +1,87 @@
+// Plain request and view structs of the dispatch service: what clients ask for and what they see.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "maps/geo.hpp"
+#include "planner/route.hpp"
+#include "preemption/engine.hpp"
+
+namespace corridor::server {
+
+using MissionId = std::uint64_t;
+
+enum class MissionState { active, completed, cancelled };
+const char* to_string(MissionState s);
+std::optional<MissionState> mission_state_from(const std::string& s);
+
+struct MissionRequest {
+  std::string vehicle_id;
+  maps::LatLon destination;
+  std::optional<maps::LatLon> origin;  // else the vehicle's last known position
+  int priority = 1;
+  double vmax_kmh = 120.0;
+};
+
+struct PositionReport {
+  std::string vehicle_id;
+  maps::LatLon position;
+  std::optional<double> heading_deg;
+  std::optional<double> speed_mps;
+  std::optional<double> hdop;
+  double timestamp_s = 0;
+  std::string source = "gps";  // gps | vo
+};
+
+struct CongestionUpdate {
+  std::optional<EdgeId> edge;
+  std::optional<std::int64_t> osm_way_id;
+  std::optional<double> speed_kmh;
+  std::optional<double> travel_time_s;
+  std::optional<double> factor;
+  std::optional<double> expires_in_s;
+};
+
+struct MissionView {
+  MissionId id = 0;
+  std::string vehicle_id;
+  MissionState state = MissionState::active;
+  int priority = 1;
+  double vmax_kmh = 120.0;
+  maps::LatLon destination;
+  std::optional<maps::LatLon> last_position;
+  planner::Route route;
+  std::uint32_t route_revision = 0;
+  std::vector<preemption::ScheduleEntry> schedule;
+  double created_s = 0;
+  double updated_s = 0;
+};
+
+struct PositionResult {
+  std::optional<MissionId> mission;  // the vehicle's active mission, if any
+  double snap_distance_m = 0;
+  bool route_changed = false;
+  bool completed = false;
+  double eta_s = 0;
+};
+
+struct CongestionResult {
+  std::size_t edges_changed = 0;
+  std::size_t missions_replanned = 0;
+  std::size_t routes_changed = 0;
+};
+
+// What the service tells listeners (the WebSocket stream): kind and mission, with a JSON payload
+// built by the codec.
+struct DispatchEvent {
+  std::string kind;  // mission_created, mission_completed, mission_cancelled, route_changed, position,
+                     // preemption_<kind>, congestion_applied
+  MissionId mission = 0;
+  std::string reason;
+  double time_s = 0;
+};
+
+}  // namespace corridor::server

@@ -1,0 +1,286 @@
+#include "server/store.hpp"
+
+#include <sqlite3.h>
+
+#include <array>
+#include <cmath>
+
+namespace corridor::server {
+namespace {
+
+// Each entry moves the schema one version up; never edit a released entry, append a new one.
+constexpr std::array<const char*, 1> kMigrations{
+    R"sql(
+    CREATE TABLE missions (
+      id INTEGER PRIMARY KEY AUTOINCREMENT,
+      vehicle_id TEXT NOT NULL,
+      priority INTEGER NOT NULL,
+      vmax_kmh REAL NOT NULL,
+      dest_lat REAL NOT NULL, dest_lon REAL NOT NULL,
+      origin_lat REAL, origin_lon REAL,
+      state TEXT NOT NULL,
+      created_s REAL NOT NULL,
+      updated_s REAL NOT NULL);
+    CREATE INDEX missions_state ON missions(state);
+    CREATE TABLE positions (
+      id INTEGER PRIMARY KEY AUTOINCREMENT,
+      vehicle_id TEXT NOT NULL,
+      mission_id INTEGER,
+      lat REAL NOT NULL, lon REAL NOT NULL,
+      heading_deg REAL, speed_mps REAL, hdop REAL,
+      timestamp_s REAL NOT NULL,
+      source TEXT NOT NULL,
+      received_s REAL NOT NULL);
+    CREATE INDEX positions_vehicle ON positions(vehicle_id, id);
+    CREATE TABLE route_revisions (
+      mission_id INTEGER NOT NULL,
+      revision INTEGER NOT NULL,
+      reason TEXT NOT NULL,
+      eta_s REAL NOT NULL,
+      length_m REAL NOT NULL,
+      geometry TEXT NOT NULL,
+      created_s REAL NOT NULL,
+      PRIMARY KEY (mission_id, revision));
+    CREATE TABLE congestion (
+      id INTEGER PRIMARY KEY AUTOINCREMENT,
+      edge INTEGER NOT NULL,
+      factor REAL,
+      queue_delay_s REAL NOT NULL,
+      expires_at_s REAL,
+      created_s REAL NOT NULL);
+    CREATE INDEX congestion_edge ON congestion(edge, id);
+    CREATE TABLE preemption_events (
+      id INTEGER PRIMARY KEY AUTOINCREMENT,
+      mission_id INTEGER NOT NULL,
+      node INTEGER NOT NULL,
+      kind TEXT NOT NULL,
+      detail TEXT NOT NULL,
+      time_s REAL NOT NULL);
+    )sql",
+};
+
+class Statement {
+ public:
+  Statement(sqlite3* db, const char* sql) {
+    if (sqlite3_prepare_v2(db, sql, -1, &stmt_, nullptr) != SQLITE_OK) {
+      throw StoreError(std::string("cannot prepare statement: ") + sqlite3_errmsg(db));
+    }
+  }
+  ~Statement() { sqlite3_finalize(stmt_); }
+  Statement(const Statement&) = delete;
+  Statement& operator=(const Statement&) = delete;
+
+  Statement& bind(int i, double v) { return check(sqlite3_bind_double(stmt_, i, v)); }
+  Statement& bind(int i, std::int64_t v) { return check(sqlite3_bind_int64(stmt_, i, v)); }
+  Statement& bind(int i, const std::string& v) {
+    return check(sqlite3_bind_text(stmt_, i, v.c_str(), static_cast<int>(v.size()), SQLITE_TRANSIENT));
+  }
+  Statement& bind(int i, std::optional<double> v) {
+    return v && std::isfinite(*v) ? bind(i, *v) : check(sqlite3_bind_null(stmt_, i));
+  }
+  // True while rows come; throws on error.
+  bool step() {
+    const int rc = sqlite3_step(stmt_);
+    if (rc == SQLITE_ROW) return true;
+    if (rc == SQLITE_DONE) return false;
+    throw StoreError(std::string("database write failed: ") + sqlite3_errmsg(sqlite3_db_handle(stmt_)));
+  }
+  [[nodiscard]] double real(int col) const { return sqlite3_column_double(stmt_, col); }
+  [[nodiscard]] std::int64_t integer(int col) const { return sqlite3_column_int64(stmt_, col); }
+  [[nodiscard]] bool null(int col) const { return sqlite3_column_type(stmt_, col) == SQLITE_NULL; }
+  [[nodiscard]] std::optional<double> optional_real(int col) const {
+    return null(col) ? std::nullopt : std::optional<double>(real(col));
+  }
+  [[nodiscard]] std::string text(int col) const {
+    const auto* p = sqlite3_column_text(stmt_, col);
+    return p == nullptr ? std::string{} : std::string(reinterpret_cast<const char*>(p));
+  }
+
+ private:
+  Statement& check(int rc) {
+    if (rc != SQLITE_OK) throw StoreError("cannot bind statement parameter");
+    return *this;
+  }
+  sqlite3_stmt* stmt_ = nullptr;
+};
+
+}  // namespace
+
+Store::Store(const std::filesystem::path& file, Durability durability) : file_(file) {
+  if (sqlite3_open_v2(file.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX, nullptr) !=
+      SQLITE_OK) {
+    const std::string why = db_ != nullptr ? sqlite3_errmsg(db_) : "out of memory";
+    sqlite3_close(db_);
+    throw StoreError("cannot open database '" + file.string() + "': " + why);
+  }
+  sqlite3_busy_timeout(db_, 5000);
+  try {
+    exec("PRAGMA journal_mode=WAL");
+    exec(durability == Durability::power_loss ? "PRAGMA synchronous=FULL" : "PRAGMA synchronous=NORMAL");
+    exec("PRAGMA foreign_keys=ON");
+    exec("CREATE TABLE IF NOT EXISTS schema_migrations (version INTEGER PRIMARY KEY, applied_s REAL NOT NULL)");
+    migrate();
+  } catch (...) {
+    sqlite3_close(db_);
+    throw;
+  }
+}
+
+Store::~Store() { sqlite3_close(db_); }
+
+void Store::exec(const std::string& sql) const {
+  char* err = nullptr;
+  if (sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, &err) != SQLITE_OK) {
+    const std::string why = err != nullptr ? err : "unknown error";
+    sqlite3_free(err);
+    throw StoreError("database '" + file_.string() + "': " + why);
+  }
+}
+
+int Store::schema_version() const {
+  Statement s(db_, "SELECT COALESCE(MAX(version), 0) FROM schema_migrations");
+  s.step();
+  return static_cast<int>(s.integer(0));
+}
+
+void Store::migrate() {
+  const int current = schema_version();
+  if (current > static_cast<int>(kMigrations.size())) {
+    throw StoreError("database '" + file_.string() + "' has schema version " + std::to_string(current) +
+                     ", newer than this build (" + std::to_string(kMigrations.size()) + "); refusing to touch it");
+  }
+  for (int v = current; v < static_cast<int>(kMigrations.size()); ++v) {
+    Transaction tx(*this);
+    exec(kMigrations[static_cast<std::size_t>(v)]);
+    Statement s(db_, "INSERT INTO schema_migrations(version, applied_s) VALUES (?, strftime('%s','now'))");
+    s.bind(1, static_cast<std::int64_t>(v + 1)).step();
+    tx.commit();
+  }
+}
+
+Store::Transaction::Transaction(Store& store) : store_(store) { store_.exec("BEGIN IMMEDIATE"); }
+Store::Transaction::~Transaction() {
+  if (!done_) {
+    try {
+      store_.exec("ROLLBACK");
+    } catch (...) {  // a destructor must not throw; the connection rolls back on close anyway
+    }
+  }
+}
+void Store::Transaction::commit() {
+  store_.exec("COMMIT");
+  done_ = true;
+}
+
+MissionId Store::insert_mission(const MissionRow& r) {
+  Statement s(db_,
+              "INSERT INTO missions(vehicle_id, priority, vmax_kmh, dest_lat, dest_lon, origin_lat, origin_lon, state, "
+              "created_s, updated_s) VALUES (?,?,?,?,?,?,?,?,?,?)");
+  s.bind(1, r.vehicle_id).bind(2, static_cast<std::int64_t>(r.priority)).bind(3, r.vmax_kmh);
+  s.bind(4, r.destination.lat_deg).bind(5, r.destination.lon_deg);
+  s.bind(6, r.origin ? std::optional<double>(r.origin->lat_deg) : std::nullopt);
+  s.bind(7, r.origin ? std::optional<double>(r.origin->lon_deg) : std::nullopt);
+  s.bind(8, std::string(to_string(r.state))).bind(9, r.created_s).bind(10, r.updated_s);
+  s.step();
+  return static_cast<MissionId>(sqlite3_last_insert_rowid(db_));
+}
+
+void Store::update_mission_state(MissionId id, MissionState state, double time_s) {
+  Statement s(db_, "UPDATE missions SET state = ?, updated_s = ? WHERE id = ?");
+  s.bind(1, std::string(to_string(state))).bind(2, time_s).bind(3, static_cast<std::int64_t>(id)).step();
+}
+
+void Store::insert_position(const PositionReport& p, std::optional<MissionId> mission, double received_s) {
+  Statement s(db_,
+              "INSERT INTO positions(vehicle_id, mission_id, lat, lon, heading_deg, speed_mps, hdop, timestamp_s, "
+              "source, received_s) VALUES (?,?,?,?,?,?,?,?,?,?)");
+  s.bind(1, p.vehicle_id);
+  s.bind(2, mission ? std::optional<double>(static_cast<double>(*mission)) : std::nullopt);
+  s.bind(3, p.position.lat_deg).bind(4, p.position.lon_deg).bind(5, p.heading_deg).bind(6, p.speed_mps).bind(7, p.hdop);
+  s.bind(8, p.timestamp_s).bind(9, p.source).bind(10, received_s).step();
+}
+
+void Store::insert_route_revision(MissionId mission, std::uint32_t revision, const std::string& reason, double eta_s,
+                                  double length_m, const std::string& geometry_json, double time_s) {
+  Statement s(db_,
+              "INSERT OR REPLACE INTO route_revisions(mission_id, revision, reason, eta_s, length_m, geometry, "
+              "created_s) VALUES (?,?,?,?,?,?,?)");
+  s.bind(1, static_cast<std::int64_t>(mission)).bind(2, static_cast<std::int64_t>(revision)).bind(3, reason);
+  s.bind(4, eta_s).bind(5, length_m).bind(6, geometry_json).bind(7, time_s).step();
+}
+
+void Store::insert_congestion(EdgeId edge, const planner::EdgeCondition& c, std::optional<double> expires_at_s,
+                              double time_s) {
+  Statement s(db_,
+              "INSERT INTO congestion(edge, factor, queue_delay_s, expires_at_s, created_s) VALUES (?,?,?,?,?)");
+  // NULL factor stands for a closure (infinity is not a SQL value).
+  s.bind(1, static_cast<std::int64_t>(edge.v)).bind(2, std::optional<double>(c.congestion_factor));
+  s.bind(3, c.queue_delay_s).bind(4, expires_at_s).bind(5, time_s).step();
+}
+
+void Store::insert_preemption_event(const preemption::PreemptionEvent& e) {
+  Statement s(db_, "INSERT INTO preemption_events(mission_id, node, kind, detail, time_s) VALUES (?,?,?,?,?)");
+  s.bind(1, static_cast<std::int64_t>(e.mission)).bind(2, static_cast<std::int64_t>(e.node.v)).bind(3, e.kind);
+  s.bind(4, e.detail).bind(5, e.time_s).step();
+}
+
+std::vector<MissionRow> Store::missions(std::optional<MissionState> state) const {
+  Statement s(db_, state ? "SELECT id, vehicle_id, priority, vmax_kmh, dest_lat, dest_lon, origin_lat, origin_lon, state, "
+                           "created_s, updated_s FROM missions WHERE state = ? ORDER BY id"
+                         : "SELECT id, vehicle_id, priority, vmax_kmh, dest_lat, dest_lon, origin_lat, origin_lon, state, "
+                           "created_s, updated_s FROM missions ORDER BY id");
+  if (state) s.bind(1, std::string(to_string(*state)));
+  std::vector<MissionRow> out;
+  while (s.step()) {
+    MissionRow r;
+    r.id = static_cast<MissionId>(s.integer(0));
+    r.vehicle_id = s.text(1);
+    r.priority = static_cast<int>(s.integer(2));
+    r.vmax_kmh = s.real(3);
+    r.destination = {s.real(4), s.real(5)};
+    if (!s.null(6)) r.origin = maps::LatLon{s.real(6), s.real(7)};
+    r.state = mission_state_from(s.text(8)).value_or(MissionState::cancelled);
+    r.created_s = s.real(9);
+    r.updated_s = s.real(10);
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
+std::optional<PositionRow> Store::last_position(const std::string& vehicle_id) const {
+  Statement s(db_, "SELECT lat, lon, heading_deg, timestamp_s FROM positions WHERE vehicle_id = ? ORDER BY id DESC LIMIT 1");
+  s.bind(1, vehicle_id);
+  if (!s.step()) return std::nullopt;
+  return PositionRow{vehicle_id, {s.real(0), s.real(1)}, s.optional_real(2), s.real(3)};
+}
+
+std::vector<CongestionRow> Store::congestion_in_force(double now_s) const {
+  Statement s(db_,
+              "SELECT c.edge, c.factor, c.queue_delay_s, c.expires_at_s FROM congestion c "
+              "JOIN (SELECT edge, MAX(id) AS id FROM congestion GROUP BY edge) latest ON latest.id = c.id "
+              "WHERE c.expires_at_s IS NULL OR c.expires_at_s > ? ORDER BY c.edge");
+  s.bind(1, now_s);
+  std::vector<CongestionRow> out;
+  while (s.step()) {
+    CongestionRow r;
+    r.edge = EdgeId{static_cast<std::uint32_t>(s.integer(0))};
+    r.condition.congestion_factor = s.null(1) ? planner::kInfCost : s.real(1);
+    r.condition.queue_delay_s = s.real(2);
+    r.expires_at_s = s.optional_real(3);
+    out.push_back(r);
+  }
+  return out;
+}
+
+std::size_t Store::count(const std::string& table) const {
+  for (const char* allowed : {"missions", "positions", "route_revisions", "congestion", "preemption_events"}) {
+    if (table == allowed) {
+      Statement s(db_, ("SELECT COUNT(*) FROM " + table).c_str());
+      s.step();
+      return static_cast<std::size_t>(s.integer(0));
+    }
+  }
+  throw StoreError("unknown table '" + table + "'");
+}
+
+}  // namespace corridor::server

@@ -1,0 +1,104 @@
+// SQLite persistence (WAL) of everything the dispatch service acknowledges: missions, positions,
+// route revisions, congestion updates and preemption events, with versioned migrations. Writes
+// complete before the caller acknowledges; restart recovery reads them back.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "maps/ids.hpp"
+#include "planner/cost_overlay.hpp"
+#include "server/dispatch_types.hpp"
+
+struct sqlite3;
+struct sqlite3_stmt;
+
+namespace corridor::server {
+
+class StoreError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct MissionRow {
+  MissionId id = 0;
+  std::string vehicle_id;
+  int priority = 1;
+  double vmax_kmh = 120.0;
+  maps::LatLon destination;
+  std::optional<maps::LatLon> origin;
+  MissionState state = MissionState::active;
+  double created_s = 0;
+  double updated_s = 0;
+};
+
+struct PositionRow {
+  std::string vehicle_id;
+  maps::LatLon position;
+  std::optional<double> heading_deg;
+  double timestamp_s = 0;
+};
+
+struct CongestionRow {
+  EdgeId edge;
+  planner::EdgeCondition condition;
+  std::optional<double> expires_at_s;
+};
+
+enum class Durability {
+  process_crash,  // synchronous=NORMAL: survives kill -9, not power loss
+  power_loss,     // synchronous=FULL
+};
+
+class Store {
+ public:
+  // Opens or creates the database and applies pending migrations. Throws StoreError.
+  explicit Store(const std::filesystem::path& file, Durability durability = Durability::process_crash);
+  ~Store();
+  Store(const Store&) = delete;
+  Store& operator=(const Store&) = delete;
+
+  [[nodiscard]] int schema_version() const;
+
+  // Groups writes into one atomic commit.
+  class Transaction {
+   public:
+    explicit Transaction(Store& store);
+    ~Transaction();
+    Transaction(const Transaction&) = delete;
+    Transaction& operator=(const Transaction&) = delete;
+    void commit();
+
+   private:
+    Store& store_;
+    bool done_ = false;
+  };
+
+  MissionId insert_mission(const MissionRow& row);
+  void update_mission_state(MissionId id, MissionState state, double time_s);
+  void insert_position(const PositionReport& report, std::optional<MissionId> mission, double received_s);
+  void insert_route_revision(MissionId mission, std::uint32_t revision, const std::string& reason, double eta_s,
+                             double length_m, const std::string& geometry_json, double time_s);
+  void insert_congestion(EdgeId edge, const planner::EdgeCondition& condition, std::optional<double> expires_at_s,
+                         double time_s);
+  void insert_preemption_event(const preemption::PreemptionEvent& event);
+
+  [[nodiscard]] std::vector<MissionRow> missions(std::optional<MissionState> state) const;
+  [[nodiscard]] std::optional<PositionRow> last_position(const std::string& vehicle_id) const;
+  // The latest condition of every edge whose latest update has not expired by `now_s`.
+  [[nodiscard]] std::vector<CongestionRow> congestion_in_force(double now_s) const;
+  [[nodiscard]] std::size_t count(const std::string& table) const;
+
+ private:
+  void exec(const std::string& sql) const;
+  void migrate();
+
+  sqlite3* db_ = nullptr;
+  std::filesystem::path file_;
+};
+
+}  // namespace corridor::server
