@@ -1,0 +1,48 @@
+#include "server/auth.hpp"
+
+namespace corridor::server {
+
+void TokenAuth::add(const std::string& token, Principal principal) {
+  if (token.size() < 16) throw AuthConfigError("token for '" + principal.name + "' is shorter than 16 characters");
+  if (principal.roles == 0 || (principal.roles & ~kAllRoles) != 0) {
+    throw AuthConfigError("token for '" + principal.name + "' needs at least one known role");
+  }
+  tokens_[token] = std::move(principal);
+}
+
+void TokenAuth::add_from_config(const nlohmann::json& config) {
+  auto it = config.find("tokens");
+  if (it == config.end()) return;
+  if (!it->is_array()) throw AuthConfigError("config: 'tokens' must be an array");
+  for (const auto& t : *it) {
+    if (!t.is_object() || !t.contains("token") || !t["token"].is_string()) {
+      throw AuthConfigError("config: every token needs a string 'token'");
+    }
+    Principal p;
+    p.name = t.value("name", std::string("unnamed"));
+    if (!t.contains("roles") || !t["roles"].is_array()) throw AuthConfigError("config: token '" + p.name + "' needs 'roles'");
+    for (const auto& r : t["roles"]) {
+      const std::string role = r.is_string() ? r.get<std::string>() : "";
+      if (role == "dispatcher") p.roles |= static_cast<std::uint8_t>(Role::dispatcher);
+      else if (role == "vehicle") p.roles |= static_cast<std::uint8_t>(Role::vehicle);
+      else if (role == "sensor") p.roles |= static_cast<std::uint8_t>(Role::sensor);
+      else if (role == "viewer") p.roles |= static_cast<std::uint8_t>(Role::viewer);
+      else throw AuthConfigError("config: token '" + p.name + "' has unknown role '" + role + "'");
+    }
+    if (t.contains("vehicle_id")) {
+      if (!t["vehicle_id"].is_string()) throw AuthConfigError("config: 'vehicle_id' must be a string");
+      p.vehicle_id = t["vehicle_id"].get<std::string>();
+    }
+    add(t["token"].get<std::string>(), std::move(p));
+  }
+}
+
+std::optional<Principal> TokenAuth::authenticate(std::string_view authorization) const {
+  constexpr std::string_view kBearer = "Bearer ";
+  if (authorization.size() <= kBearer.size() || authorization.substr(0, kBearer.size()) != kBearer) return std::nullopt;
+  auto it = tokens_.find(std::string(authorization.substr(kBearer.size())));
+  if (it == tokens_.end()) return std::nullopt;
+  return it->second;
+}
+
+}  // namespace corridor::server

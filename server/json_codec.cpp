@@ -1,0 +1,187 @@
+#include "server/json_codec.hpp"
+
+#include <cmath>
+
+#include "maps/geo.hpp"
+#include "planner/route_geojson.hpp"
+#include "server/api_error.hpp"
+
+namespace corridor::server {
+namespace {
+
+using nlohmann::json;
+
+const json& require(const json& j, const char* key) {
+  if (!j.is_object()) throw bad_request("request body must be a JSON object");
+  auto it = j.find(key);
+  if (it == j.end() || it->is_null()) throw bad_request(std::string("missing field '") + key + "'");
+  return *it;
+}
+
+double number(const json& v, const char* key) {
+  if (!v.is_number()) throw bad_request(std::string("field '") + key + "' must be a number");
+  const double d = v.get<double>();
+  if (!std::isfinite(d)) throw bad_request(std::string("field '") + key + "' must be finite");
+  return d;
+}
+
+std::optional<double> optional_number(const json& j, const char* key) {
+  auto it = j.find(key);
+  if (it == j.end() || it->is_null()) return std::nullopt;
+  return number(*it, key);
+}
+
+std::string string_field(const json& j, const char* key) {
+  const json& v = require(j, key);
+  if (!v.is_string()) throw bad_request(std::string("field '") + key + "' must be a string");
+  return v.get<std::string>();
+}
+
+maps::LatLon lat_lon(const json& v, const char* key) {
+  if (!v.is_object()) throw bad_request(std::string("field '") + key + "' must be an object {lat, lon}");
+  const maps::LatLon p{number(require(v, "lat"), "lat"), number(require(v, "lon"), "lon")};
+  if (!maps::is_valid_lat_lon(p)) {
+    throw unprocessable("invalid_coordinate", std::string("field '") + key +
+                                                  "' is not a coordinate: lat must be within [-90, 90], lon within [-180, 180]");
+  }
+  return p;
+}
+
+maps::Compass compass(const std::string& s) {
+  if (s == "N") return maps::Compass::north;
+  if (s == "E") return maps::Compass::east;
+  if (s == "S") return maps::Compass::south;
+  if (s == "W") return maps::Compass::west;
+  throw bad_request("approach must be one of \"N\", \"E\", \"S\", \"W\"");
+}
+
+json ll(maps::LatLon p) { return {{"lat", p.lat_deg}, {"lon", p.lon_deg}}; }
+
+}  // namespace
+
+json parse_body(const std::string& body) {
+  if (body.empty()) throw bad_request("request body is empty; expected JSON");
+  json j = json::parse(body, nullptr, false);
+  if (j.is_discarded()) throw bad_request("request body is not valid JSON");
+  return j;
+}
+
+MissionRequest mission_request_from_json(const json& j) {
+  MissionRequest r;
+  r.vehicle_id = string_field(j, "vehicle_id");
+  r.destination = lat_lon(require(j, "destination"), "destination");
+  if (auto it = j.find("origin"); it != j.end() && !it->is_null()) r.origin = lat_lon(*it, "origin");
+  if (auto it = j.find("priority"); it != j.end()) {
+    if (!it->is_number_integer() || it->get<std::int64_t>() < 0 || it->get<std::int64_t>() > 10) {
+      throw bad_request("field 'priority' must be an integer from 0 to 10");
+    }
+    r.priority = static_cast<int>(it->get<std::int64_t>());
+  }
+  if (auto v = optional_number(j, "vmax_kmh")) r.vmax_kmh = *v;
+  return r;
+}
+
+PositionReport position_from_json(const json& j, const std::string& vehicle_id) {
+  PositionReport p;
+  p.vehicle_id = vehicle_id;
+  p.position = {number(require(j, "lat"), "lat"), number(require(j, "lon"), "lon")};
+  if (!maps::is_valid_lat_lon(p.position)) {
+    throw unprocessable("invalid_coordinate", "lat must be within [-90, 90] and lon within [-180, 180]");
+  }
+  p.timestamp_s = number(require(j, "timestamp"), "timestamp");
+  p.heading_deg = optional_number(j, "heading_deg");
+  p.speed_mps = optional_number(j, "speed_mps");
+  p.hdop = optional_number(j, "hdop");
+  if (auto it = j.find("source"); it != j.end()) {
+    if (!it->is_string()) throw bad_request("field 'source' must be \"gps\" or \"vo\"");
+    p.source = it->get<std::string>();
+  }
+  return p;
+}
+
+std::vector<CongestionUpdate> congestion_from_json(const json& j) {
+  const json& list = require(j, "updates");
+  if (!list.is_array()) throw bad_request("field 'updates' must be an array");
+  std::vector<CongestionUpdate> out;
+  for (const json& u : list) {
+    if (!u.is_object()) throw bad_request("each update must be an object");
+    CongestionUpdate c;
+    if (auto it = u.find("edge"); it != u.end()) {
+      if (!it->is_number_unsigned() || it->get<std::uint64_t>() >= 0xffffffffULL) {
+        throw bad_request("field 'edge' must be a non-negative integer edge id");
+      }
+      c.edge = EdgeId{static_cast<std::uint32_t>(it->get<std::uint64_t>())};
+    }
+    if (auto it = u.find("osm_way_id"); it != u.end()) {
+      if (!it->is_number_integer()) throw bad_request("field 'osm_way_id' must be an integer");
+      c.osm_way_id = it->get<std::int64_t>();
+    }
+    c.speed_kmh = optional_number(u, "speed_kmh");
+    c.travel_time_s = optional_number(u, "travel_time_s");
+    c.factor = optional_number(u, "factor");
+    c.expires_in_s = optional_number(u, "expires_in_s");
+    out.push_back(c);
+  }
+  return out;
+}
+
+CountsReport counts_from_json(const json& j) {
+  CountsReport c;
+  c.approach = compass(string_field(j, "approach"));
+  c.arrivals = number(require(j, "arrivals"), "arrivals");
+  c.departures = number(require(j, "departures"), "departures");
+  return c;
+}
+
+json schedule_to_json(const maps::RoadGraph& graph, const std::vector<preemption::ScheduleEntry>& schedule) {
+  json out = json::array();
+  for (const auto& e : schedule) {
+    const maps::LatLon at = graph.projection().to_lat_lon(graph.position(e.node));
+    out.push_back({{"signal", e.node.v},
+                   {"osm_node", graph.osm_node(e.node).v},
+                   {"location", ll(at)},
+                   {"movement", e.movement_label},
+                   {"phase", e.phase.label},
+                   {"congestion", e.congestion == preemption::CongestionLevel::high ? "high" : "low"},
+                   {"start_s", e.start_s},
+                   {"arrival_s", e.arrival_s},
+                   {"release_s", e.release_s},
+                   {"state", preemption::to_string(e.state)},
+                   {"deferred", e.deferred}});
+  }
+  return out;
+}
+
+json mission_to_json(const maps::RoadGraph& graph, const MissionView& m) {
+  json j{{"id", m.id},
+         {"vehicle_id", m.vehicle_id},
+         {"state", to_string(m.state)},
+         {"priority", m.priority},
+         {"vmax_kmh", m.vmax_kmh},
+         {"destination", ll(m.destination)},
+         {"route_revision", m.route_revision},
+         {"created_s", m.created_s},
+         {"updated_s", m.updated_s},
+         {"preemption", schedule_to_json(graph, m.schedule)}};
+  j["last_position"] = m.last_position ? ll(*m.last_position) : json(nullptr);
+  if (!m.route.edges.empty()) {
+    j["route"] = planner::route_to_geojson(graph, m.route, "dstar");
+    j["eta_s"] = m.route.found ? json(m.route.travel_time_s) : json(nullptr);
+  } else {
+    j["route"] = nullptr;
+    j["eta_s"] = nullptr;
+  }
+  return j;
+}
+
+json event_to_json(const DispatchEvent& e) {
+  json j{{"type", e.kind}, {"time_s", e.time_s}, {"reason", e.reason}};
+  j["mission"] = e.mission == 0 ? json(nullptr) : json(e.mission);
+  return j;
+}
+
+json error_json(const std::string& code, const std::string& message) {
+  return {{"error", {{"code", code}, {"message", message}}}};
+}
+
+}  // namespace corridor::server

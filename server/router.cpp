@@ -1,0 +1,318 @@
+#include "server/router.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <sstream>
+
+#include "maps/errors.hpp"
+#include "server/json_codec.hpp"
+
+namespace corridor::server {
+namespace {
+
+using nlohmann::json;
+
+constexpr std::uint8_t kRead = static_cast<std::uint8_t>(Role::viewer) | static_cast<std::uint8_t>(Role::dispatcher);
+constexpr std::uint8_t kDispatch = static_cast<std::uint8_t>(Role::dispatcher);
+constexpr std::uint8_t kSensor = static_cast<std::uint8_t>(Role::sensor);
+constexpr std::uint8_t kVehicle = static_cast<std::uint8_t>(Role::vehicle);
+
+std::vector<std::string> split_path(const std::string& path) {
+  std::vector<std::string> parts;
+  std::string part;
+  std::istringstream in(path);
+  while (std::getline(in, part, '/')) {
+    if (!part.empty()) parts.push_back(part);
+  }
+  return parts;
+}
+
+std::uint64_t parse_id(const std::string& s, const char* what) {
+  if (s.empty() || s.size() > 18 || s.find_first_not_of("0123456789") != std::string::npos) {
+    throw bad_request(std::string(what) + " must be a positive integer, got '" + s.substr(0, 40) + "'");
+  }
+  return std::stoull(s);
+}
+
+json map_feature_collection(const maps::RoadGraph& g) {
+  json features = json::array();
+  for (EdgeId e : g.edges()) {
+    if (g.twin(e).valid() && g.twin(e) < e) continue;  // one feature per road
+    json coords = json::array();
+    for (const auto& p : g.geometry(e)) {
+      const maps::LatLon ll = g.projection().to_lat_lon(p);
+      coords.push_back({std::round(ll.lon_deg * 1e7) / 1e7, std::round(ll.lat_deg * 1e7) / 1e7});
+    }
+    features.push_back({{"type", "Feature"},
+                        {"geometry", {{"type", "LineString"}, {"coordinates", std::move(coords)}}},
+                        {"properties",
+                         {{"edge", e.v},
+                          {"twin", g.twin(e).valid() ? json(g.twin(e).v) : json(nullptr)},
+                          {"osm_way_id", g.osm_way(e).v},
+                          {"class", std::string(maps::to_string(g.road_class(e)))},
+                          {"speed_kmh", g.speed_mps(e) * 3.6},
+                          {"length_m", g.length_m(e)}}}});
+  }
+  return {{"type", "FeatureCollection"},
+          {"features", std::move(features)},
+          {"attribution", "© OpenStreetMap contributors, ODbL 1.0"}};
+}
+
+}  // namespace
+
+Router::Router(DispatchService& service, TokenAuth auth, RouterConfig config, Clock clock)
+    : service_(service), auth_(std::move(auth)), config_(config), clock_(std::move(clock)) {
+  map_geojson_ = map_feature_collection(service_.graph()).dump();
+  service_.subscribe([this](const DispatchEvent& e) {
+    if (e.kind == "route_changed") metrics_.count("route_changes_total");
+    if (e.kind.rfind("preemption_", 0) == 0) metrics_.count(e.kind + "_total");
+  });
+
+  add("GET", "/v1/health", 0, "Liveness, map size and active missions", [this](const Principal&, const Match&, const HttpRequest&) {
+    return json_response(200, {{"status", "ok"},
+                               {"active_missions", service_.active_mission_count()},
+                               {"map", {{"nodes", service_.graph().node_count()}, {"edges", service_.graph().edge_count()}}}});
+  });
+  add("GET", "/metrics", 0, "Prometheus metrics", [this](const Principal&, const Match&, const HttpRequest&) {
+    metrics_.set_gauge("active_missions", static_cast<double>(service_.active_mission_count()));
+    return HttpResponse{200, "text/plain; version=0.0.4", metrics_.render()};
+  });
+  add("GET", "/v1/openapi.json", 0, "This API description", [this](const Principal&, const Match&, const HttpRequest&) {
+    return json_response(200, openapi());
+  });
+  add("GET", "/v1/map", kRead, "The road graph as GeoJSON", [this](const Principal&, const Match&, const HttpRequest&) {
+    return HttpResponse{200, "application/geo+json", map_geojson_};
+  });
+  add("POST", "/v1/missions", kDispatch, "Create a mission", [this](const Principal&, const Match&, const HttpRequest& r) {
+    const auto started = std::chrono::steady_clock::now();
+    const MissionView m = service_.create_mission(mission_request_from_json(parse_body(r.body)), clock_());
+    metrics_.observe("plan_seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+    return json_response(201, mission_to_json(service_.graph(), m));
+  });
+  add("GET", "/v1/missions", kRead, "List missions (?state=active|completed|cancelled)",
+      [this](const Principal&, const Match& m, const HttpRequest&) {
+        std::optional<MissionState> state;
+        if (auto it = m.query.find("state"); it != m.query.end()) {
+          state = mission_state_from(it->second);
+          if (!state) throw bad_request("state must be active, completed or cancelled");
+        }
+        json list = json::array();
+        for (const auto& v : service_.missions(state)) list.push_back(mission_to_json(service_.graph(), v));
+        return json_response(200, {{"missions", std::move(list)}});
+      });
+  add("GET", "/v1/missions/{id}", kRead, "One mission", [this](const Principal&, const Match& m, const HttpRequest&) {
+    return json_response(200, mission_to_json(service_.graph(), service_.mission(parse_id(m.params[0], "mission id"))));
+  });
+  add("POST", "/v1/missions/{id}/cancel", kDispatch, "Cancel a mission",
+      [this](const Principal&, const Match& m, const HttpRequest&) {
+        return json_response(200, mission_to_json(service_.graph(), service_.cancel_mission(parse_id(m.params[0], "mission id"), clock_())));
+      });
+  add("POST", "/v1/vehicles/{id}/position", kVehicle | kDispatch, "Report a vehicle position",
+      [this](const Principal& who, const Match& m, const HttpRequest& r) {
+        const std::string& vehicle = m.params[0];
+        if (!who.has(Role::dispatcher) && who.vehicle_id && *who.vehicle_id != vehicle) {
+          throw ApiError(403, "forbidden", "this token may report positions for vehicle '" + *who.vehicle_id + "' only");
+        }
+        const auto started = std::chrono::steady_clock::now();
+        const PositionResult res = service_.report_position(position_from_json(parse_body(r.body), vehicle), clock_());
+        metrics_.observe("position_replan_seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+        json out{{"accepted", true},
+                 {"snap_distance_m", res.snap_distance_m},
+                 {"route_changed", res.route_changed},
+                 {"completed", res.completed}};
+        out["mission"] = res.mission ? json(*res.mission) : json(nullptr);
+        out["eta_s"] = res.mission && !res.completed ? json(res.eta_s) : json(nullptr);
+        return json_response(200, out);
+      });
+  add("POST", "/v1/congestion", kSensor, "Report congestion on edges or OSM ways",
+      [this](const Principal&, const Match&, const HttpRequest& r) {
+        const auto started = std::chrono::steady_clock::now();
+        const CongestionResult res = service_.report_congestion(congestion_from_json(parse_body(r.body)), clock_());
+        metrics_.observe("congestion_replan_seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+        metrics_.count("replans_total", static_cast<double>(res.missions_replanned));
+        return json_response(200, {{"edges_changed", res.edges_changed},
+                                   {"missions_replanned", res.missions_replanned},
+                                   {"routes_changed", res.routes_changed}});
+      });
+  add("POST", "/v1/signals/{id}/counts", kSensor, "Detector counts for a signal's approach",
+      [this](const Principal&, const Match& m, const HttpRequest& r) {
+        const auto id = parse_id(m.params[0], "signal id");
+        if (id >= service_.graph().node_count()) throw not_found("no signal " + m.params[0]);
+        const CountsReport c = counts_from_json(parse_body(r.body));
+        service_.report_counts(NodeId{static_cast<std::uint32_t>(id)}, c.approach, c.arrivals, c.departures, clock_());
+        return json_response(200, {{"accepted", true}});
+      });
+  auto signal_json = [this](NodeId n, const maps::SignalPlan& plan) {
+    json lights = json::array();
+    const auto shown = service_.signal_lights(n);
+    for (std::size_t i = 0; i < plan.movements.size(); ++i) {
+      const char* light = shown[i] == preemption::Light::green ? "green" : shown[i] == preemption::Light::yellow ? "yellow" : "red";
+      lights.push_back({{"movement", plan.movements[i].label()}, {"light", light}});
+    }
+    const maps::LatLon at = service_.graph().projection().to_lat_lon(service_.graph().position(n));
+    json phases = json::array();
+    for (const auto& p : plan.phases) phases.push_back(p.label);
+    return json{{"id", n.v}, {"osm_node", service_.graph().osm_node(n).v}, {"location", {{"lat", at.lat_deg}, {"lon", at.lon_deg}}},
+                {"phases", std::move(phases)}, {"lights", std::move(lights)}};
+  };
+  add("GET", "/v1/signals", kRead, "Every signalized intersection", [this, signal_json](const Principal&, const Match&, const HttpRequest&) {
+    json list = json::array();
+    std::vector<NodeId> ids;
+    for (const auto& [n, plan] : service_.signal_plans()) ids.push_back(n);
+    std::sort(ids.begin(), ids.end());
+    for (NodeId n : ids) list.push_back(signal_json(n, service_.signal_plans().at(n)));
+    return json_response(200, {{"signals", std::move(list)}});
+  });
+  add("GET", "/v1/signals/{id}", kRead, "One signalized intersection", [this, signal_json](const Principal&, const Match& m, const HttpRequest&) {
+    const auto id = parse_id(m.params[0], "signal id");
+    auto it = id < service_.graph().node_count() ? service_.signal_plans().find(NodeId{static_cast<std::uint32_t>(id)})
+                                                 : service_.signal_plans().end();
+    if (it == service_.signal_plans().end()) throw not_found("no signal " + m.params[0]);
+    return json_response(200, signal_json(it->first, it->second));
+  });
+}
+
+void Router::add(std::string method, std::string pattern, std::uint8_t roles, std::string summary, Handler handler) {
+  routes_.push_back({std::move(method), std::move(pattern), roles, std::move(summary), std::move(handler)});
+}
+
+HttpResponse Router::json_response(int status, const json& body) const {
+  return {status, "application/json", body.dump(-1, ' ', false, json::error_handler_t::replace)};
+}
+
+bool Router::take_token(const std::string& key, double now_s) {
+  std::lock_guard lock(buckets_mutex_);
+  auto [it, fresh] = buckets_.try_emplace(key, config_.burst_per_token, now_s);
+  auto& [left, last] = it->second;
+  if (!fresh) {
+    left = std::min(config_.burst_per_token, left + (now_s - last) * config_.rate_per_token_per_s);
+    last = now_s;
+  }
+  if (left < 1.0) return false;
+  left -= 1.0;
+  return true;
+}
+
+std::optional<Principal> Router::authorize_stream(const std::string& authorization) const {
+  auto who = auth_.authenticate(authorization);
+  if (!who || (who->roles & kRead) == 0) return std::nullopt;
+  return who;
+}
+
+HttpResponse Router::handle(const HttpRequest& request) noexcept {
+  const auto started = std::chrono::steady_clock::now();
+  std::string route_name = "unmatched";
+  HttpResponse response;
+  try {
+    const auto q = request.target.find('?');
+    const std::string path = request.target.substr(0, q);
+    Match match;
+    if (q != std::string::npos) {
+      std::istringstream in(request.target.substr(q + 1));
+      std::string pair;
+      while (std::getline(in, pair, '&')) {
+        const auto eq = pair.find('=');
+        match.query[pair.substr(0, eq)] = eq == std::string::npos ? "" : pair.substr(eq + 1);
+      }
+    }
+    const auto parts = split_path(path);
+    const Route* found = nullptr;
+    bool path_known = false;
+    for (const Route& r : routes_) {
+      const auto pattern = split_path(r.pattern);
+      if (pattern.size() != parts.size()) continue;
+      std::vector<std::string> params;
+      bool ok = true;
+      for (std::size_t i = 0; i < parts.size() && ok; ++i) {
+        if (pattern[i].front() == '{') {
+          params.push_back(parts[i]);
+        } else {
+          ok = pattern[i] == parts[i];
+        }
+      }
+      if (!ok) continue;
+      path_known = true;
+      if (r.method == request.method) {
+        found = &r;
+        match.params = std::move(params);
+        break;
+      }
+    }
+    if (found == nullptr) {
+      throw path_known ? ApiError(405, "method_not_allowed", request.method + " is not allowed on " + path)
+                       : not_found("no such endpoint: " + path.substr(0, 200));
+    }
+    route_name = found->method + " " + found->pattern;
+    Principal who{"anonymous", kAllRoles, std::nullopt};
+    if (found->roles != 0) {
+      auto principal = auth_.authenticate(request.authorization);
+      if (!principal) throw ApiError(401, "unauthorized", "a valid 'Authorization: Bearer <token>' header is required");
+      if ((principal->roles & found->roles) == 0) {
+        throw ApiError(403, "forbidden", "token '" + principal->name + "' may not call " + route_name);
+      }
+      if (!take_token(principal->name, clock_())) {
+        throw ApiError(429, "rate_limited", "too many requests for token '" + principal->name + "'; slow down");
+      }
+      who = *principal;
+    }
+    response = found->handler(who, match, request);
+  } catch (const ApiError& e) {
+    response = json_response(e.status(), error_json(e.code(), e.what()));
+  } catch (const nlohmann::json::exception& e) {
+    response = json_response(400, error_json("bad_request", std::string("invalid JSON value: ") + e.what()));
+  } catch (const StoreError& e) {
+    spdlog::error("event=store_failure route=\"{}\" error=\"{}\"", route_name, e.what());
+    response = json_response(503, error_json("storage_unavailable", "the change could not be stored; it was not applied"));
+  } catch (const std::exception& e) {
+    spdlog::error("event=internal_error route=\"{}\" error=\"{}\"", route_name, e.what());
+    response = json_response(500, error_json("internal", "internal error; the request was not applied"));
+  } catch (...) {
+    response = json_response(500, error_json("internal", "internal error; the request was not applied"));
+  }
+  metrics_.observe_request(route_name, response.status,
+                           std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+  return response;
+}
+
+json Router::openapi() const {
+  json paths = json::object();
+  for (const Route& r : routes_) {
+    json op{{"summary", r.summary},
+            {"responses",
+             {{"200", {{"description", "OK"}}},
+              {"400", {{"description", "Malformed request"}, {"content", {{"application/json", {{"schema", {{"$ref", "#/components/schemas/Error"}}}}}}}}},
+              {"401", {{"description", "Missing or invalid token"}}},
+              {"403", {{"description", "Token lacks the role"}}},
+              {"404", {{"description", "Unknown id"}}},
+              {"422", {{"description", "Valid JSON that cannot be applied (off the map, unreachable)"}}}}}};
+    if (r.method == "POST" && r.pattern == "/v1/missions") op["responses"]["201"] = {{"description", "Created"}};
+    if (r.roles != 0) op["security"] = json::array({{{"bearer", json::array()}}});
+    json params = json::array();
+    for (const auto& part : split_path(r.pattern)) {
+      if (part.front() == '{') {
+        params.push_back({{"name", part.substr(1, part.size() - 2)}, {"in", "path"}, {"required", true}, {"schema", {{"type", "string"}}}});
+      }
+    }
+    if (!params.empty()) op["parameters"] = std::move(params);
+    std::string method = r.method;
+    std::transform(method.begin(), method.end(), method.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    paths[r.pattern][method] = std::move(op);
+  }
+  paths["/v1/stream"]["get"] = {{"summary", "WebSocket stream of events (upgrade); ?mission=ID to follow one mission"},
+                                {"responses", {{"101", {{"description", "Switching protocols"}}}}},
+                                {"security", json::array({{{"bearer", json::array()}}})}};
+  json error_schema = {{"type", "object"},
+                       {"properties",
+                        {{"error",
+                          {{"type", "object"},
+                           {"properties", {{"code", {{"type", "string"}}}, {"message", {{"type", "string"}}}}}}}}}};
+  json components = {{"securitySchemes", {{"bearer", {{"type", "http"}, {"scheme", "bearer"}}}}},
+                     {"schemas", {{"Error", std::move(error_schema)}}}};
+  return {{"openapi", "3.0.3"},
+          {"info", {{"title", "Corridor dispatch API"}, {"version", "1"}}},
+          {"paths", std::move(paths)},
+          {"components", std::move(components)}};
+}
+
+}  // namespace corridor::server

@@ -1,0 +1,80 @@
+// The HTTP API without the transport: one table of routes (method, path, roles, handler) that
+// answers requests, renders errors as {"error":{"code","message"}}, counts metrics, and generates
+// the OpenAPI description from the same table. Never throws, whatever the input.
+#pragma once
+
+#include <functional>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "server/auth.hpp"
+#include "server/dispatch_service.hpp"
+#include "server/metrics.hpp"
+
+namespace corridor::server {
+
+struct HttpRequest {
+  std::string method;
+  std::string target;         // path and query
+  std::string authorization;  // the Authorization header
+  std::string body;
+};
+
+struct HttpResponse {
+  int status = 200;
+  std::string content_type = "application/json";
+  std::string body;
+};
+
+struct RouterConfig {
+  double rate_per_token_per_s = 50000.0;  // token bucket refill
+  double burst_per_token = 100000.0;
+};
+
+class Router {
+ public:
+  using Clock = std::function<double()>;  // seconds; wall clock in production, fake in tests
+
+  Router(DispatchService& service, TokenAuth auth, RouterConfig config, Clock clock);
+
+  HttpResponse handle(const HttpRequest& request) noexcept;
+  // For the WebSocket upgrade: the principal if it may read the stream.
+  [[nodiscard]] std::optional<Principal> authorize_stream(const std::string& authorization) const;
+  [[nodiscard]] nlohmann::json openapi() const;
+  [[nodiscard]] Metrics& metrics() { return metrics_; }
+
+ private:
+  struct Match {
+    std::vector<std::string> params;
+    std::unordered_map<std::string, std::string> query;
+  };
+  using Handler = std::function<HttpResponse(const Principal&, const Match&, const HttpRequest&)>;
+  struct Route {
+    std::string method;
+    std::string pattern;  // "/v1/missions/{id}"
+    std::uint8_t roles;   // any of these may call; 0 = no token needed
+    std::string summary;
+    Handler handler;
+  };
+
+  void add(std::string method, std::string pattern, std::uint8_t roles, std::string summary, Handler handler);
+  bool take_token(const std::string& key, double now_s);
+  HttpResponse json_response(int status, const nlohmann::json& body) const;
+
+  DispatchService& service_;
+  TokenAuth auth_;
+  RouterConfig config_;
+  Clock clock_;
+  Metrics metrics_;
+  std::vector<Route> routes_;
+  std::string map_geojson_;  // rendered once: the graph never changes
+  std::mutex buckets_mutex_;
+  std::unordered_map<std::string, std::pair<double, double>> buckets_;  // token -> (tokens left, last refill)
+};
+
+}  // namespace corridor::server

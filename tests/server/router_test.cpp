@@ -1,0 +1,216 @@
+#include "server/router.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "maps/synthetic_grid.hpp"
+
+namespace corridor::server {
+namespace {
+
+using nlohmann::json;
+
+const maps::RoadGraph& grid() {
+  static const maps::RoadGraph g = [] {
+    maps::GridSpec spec;
+    spec.rows = 8;
+    spec.cols = 8;
+    spec.seed = 4;
+    spec.oneway_fraction = 0.0;
+    spec.signal_fraction = 0.5;
+    return maps::make_perturbed_grid(spec);
+  }();
+  return g;
+}
+
+const std::string kDispatcher = "Bearer dispatcher-token-0123456789";
+const std::string kViewer = "Bearer viewer-token-0123456789abc";
+const std::string kSensor = "Bearer sensor-token-0123456789abc";
+const std::string kAmb1 = "Bearer vehicle-amb1-token-0123456";
+
+struct Rig {
+  DispatchService service{grid(), {}, nullptr, 0.0};
+  double now = 100.0;
+  Router router;
+
+  Rig() : router(service, make_auth(), {}, [this] { return now; }) {}
+
+  static TokenAuth make_auth() {
+    TokenAuth auth;
+    auth.add_from_config(json::parse(R"({"tokens":[
+      {"token":"dispatcher-token-0123456789","name":"dispatch","roles":["dispatcher"]},
+      {"token":"viewer-token-0123456789abc","name":"wall","roles":["viewer"]},
+      {"token":"sensor-token-0123456789abc","name":"loops","roles":["sensor"]},
+      {"token":"vehicle-amb1-token-0123456","name":"amb1","roles":["vehicle"],"vehicle_id":"amb-1"}]})"));
+    return auth;
+  }
+  HttpResponse call(const std::string& method, const std::string& target, const std::string& auth = "",
+                    const std::string& body = "") {
+    return router.handle({method, target, auth, body});
+  }
+};
+
+std::string ll(NodeId n) {
+  const auto p = grid().projection().to_lat_lon(grid().position(n));
+  return "{\"lat\":" + std::to_string(p.lat_deg) + ",\"lon\":" + std::to_string(p.lon_deg) + "}";
+}
+
+std::string mission_body(const std::string& vehicle) {
+  return "{\"vehicle_id\":\"" + vehicle + "\",\"origin\":" + ll(NodeId{0}) + ",\"destination\":" +
+         ll(NodeId{static_cast<std::uint32_t>(grid().node_count() - 1)}) + ",\"priority\":2}";
+}
+
+json body(const HttpResponse& r) { return json::parse(r.body); }
+
+TEST(Router, CreateReadListCancelMission) {
+  Rig rig;
+  const auto created = rig.call("POST", "/v1/missions", kDispatcher, mission_body("amb-1"));
+  ASSERT_EQ(created.status, 201) << created.body;
+  const json m = body(created);
+  EXPECT_EQ(m["state"], "active");
+  EXPECT_EQ(m["route"]["type"], "Feature");
+  EXPECT_GT(m["eta_s"].get<double>(), 0.0);
+  EXPECT_TRUE(m["preemption"].is_array());
+  const std::string id = std::to_string(m["id"].get<std::uint64_t>());
+  EXPECT_EQ(rig.call("GET", "/v1/missions/" + id, kViewer).status, 200);
+  const json active = body(rig.call("GET", "/v1/missions?state=active", kViewer));
+  EXPECT_EQ(active["missions"].size(), 1u);
+  EXPECT_EQ(rig.call("POST", "/v1/missions/" + id + "/cancel", kDispatcher).status, 200);
+  EXPECT_EQ(body(rig.call("GET", "/v1/missions/" + id, kViewer))["state"], "cancelled");
+  EXPECT_EQ(rig.call("POST", "/v1/missions/" + id + "/cancel", kDispatcher).status, 409);
+}
+
+TEST(Router, AuthenticationAndRoles) {
+  Rig rig;
+  EXPECT_EQ(rig.call("GET", "/v1/health").status, 200);  // open
+  EXPECT_EQ(rig.call("GET", "/v1/missions").status, 401);
+  EXPECT_EQ(rig.call("GET", "/v1/missions", "Bearer not-a-token").status, 401);
+  EXPECT_EQ(rig.call("GET", "/v1/missions", "Basic abc").status, 401);
+  EXPECT_EQ(rig.call("POST", "/v1/missions", kViewer, mission_body("x")).status, 403);
+  EXPECT_EQ(rig.call("POST", "/v1/congestion", kDispatcher, R"({"updates":[{"edge":0,"factor":2}]})").status, 403);
+  EXPECT_EQ(rig.call("POST", "/v1/congestion", kSensor, R"({"updates":[{"edge":0,"factor":2}]})").status, 200);
+  const std::string pos = R"({"lat":)" + std::to_string(grid().projection().to_lat_lon(grid().position(NodeId{0})).lat_deg) +
+                          R"(,"lon":)" + std::to_string(grid().projection().to_lat_lon(grid().position(NodeId{0})).lon_deg) +
+                          R"(,"timestamp":1})";
+  EXPECT_EQ(rig.call("POST", "/v1/vehicles/amb-1/position", kAmb1, pos).status, 200);
+  const auto other = rig.call("POST", "/v1/vehicles/amb-2/position", kAmb1, pos);
+  EXPECT_EQ(other.status, 403);  // a vehicle reports for itself only
+  EXPECT_EQ(body(other)["error"]["code"], "forbidden");
+  // The token never appears in an error message.
+  EXPECT_EQ(rig.call("GET", "/v1/missions", kAmb1).body.find("vehicle-amb1-token"), std::string::npos);
+}
+
+TEST(Router, BadInputsGetClearFourHundreds) {
+  Rig rig;
+  const std::pair<std::string, int> cases[] = {
+      {"", 400},
+      {"{", 400},
+      {"[]", 400},
+      {"{\"vehicle_id\":5}", 400},
+      {"{\"vehicle_id\":\"a\"}", 400},
+      {"{\"vehicle_id\":\"a\",\"destination\":{\"lat\":\"x\",\"lon\":1}}", 400},
+      {"{\"vehicle_id\":\"a\",\"destination\":{\"lat\":NaN,\"lon\":1}}", 400},
+      {"{\"vehicle_id\":\"a\",\"destination\":{\"lat\":95,\"lon\":1}}", 422},
+      {"{\"vehicle_id\":\"a\",\"destination\":{\"lat\":1e400,\"lon\":1}}", 400},
+      {"{\"vehicle_id\":\"a\",\"destination\":{\"lat\":10,\"lon\":10},\"origin\":{\"lat\":10,\"lon\":10}}", 422},
+      {"{\"vehicle_id\":\"a\",\"destination\":{\"lat\":10,\"lon\":10},\"priority\":1.5}", 400},
+  };
+  for (const auto& [text, status] : cases) {
+    const auto r = rig.call("POST", "/v1/missions", kDispatcher, text);
+    EXPECT_EQ(r.status, status) << text << " -> " << r.body;
+    const json err = body(r);
+    EXPECT_TRUE(err["error"]["code"].is_string()) << r.body;
+    EXPECT_FALSE(err["error"]["message"].get<std::string>().empty());
+  }
+  EXPECT_EQ(rig.call("GET", "/v1/missions/abc", kViewer).status, 400);
+  EXPECT_EQ(rig.call("GET", "/v1/missions/99999", kViewer).status, 404);
+  EXPECT_EQ(rig.call("GET", "/v1/missions?state=flying", kViewer).status, 400);
+  EXPECT_EQ(rig.call("GET", "/v1/nothing", kViewer).status, 404);
+  EXPECT_EQ(rig.call("DELETE", "/v1/missions", kDispatcher).status, 405);
+  EXPECT_EQ(rig.call("POST", "/v1/congestion", kSensor, R"({"updates":[{"edge":-1,"factor":2}]})").status, 400);
+  EXPECT_EQ(rig.call("POST", "/v1/congestion", kSensor, R"({"updates":[{"edge":999999,"factor":2}]})").status, 422);
+  EXPECT_EQ(rig.call("POST", "/v1/congestion", kSensor, R"({"updates":"all"})").status, 400);
+  EXPECT_EQ(rig.call("POST", "/v1/signals/0/counts", kSensor, R"({"approach":"Q","arrivals":1,"departures":0})").status, 400);
+  EXPECT_EQ(rig.call("GET", "/v1/signals/123456789", kViewer).status, 404);
+  EXPECT_EQ(rig.call("POST", "/v1/vehicles/amb-1/position", kDispatcher, R"({"lat":0,"lon":0,"timestamp":1})").status, 422);
+}
+
+TEST(Router, SignalsMapHealthAndMetrics) {
+  Rig rig;
+  const json signals = body(rig.call("GET", "/v1/signals", kViewer));
+  ASSERT_FALSE(signals["signals"].empty());
+  const auto first = signals["signals"][0]["id"].get<std::uint32_t>();
+  EXPECT_EQ(rig.call("GET", "/v1/signals/" + std::to_string(first), kViewer).status, 200);
+  EXPECT_EQ(rig.call("POST", "/v1/signals/" + std::to_string(first) + "/counts", kSensor,
+                     R"({"approach":"N","arrivals":4,"departures":1})")
+                .status,
+            200);
+  const json map = body(rig.call("GET", "/v1/map", kViewer));
+  EXPECT_EQ(map["type"], "FeatureCollection");
+  EXPECT_GT(map["features"].size(), grid().edge_count() / 3);
+  const auto metrics = rig.call("GET", "/metrics");
+  EXPECT_EQ(metrics.content_type.rfind("text/plain", 0), 0u);
+  EXPECT_NE(metrics.body.find("corridor_http_requests_total{route=\"GET /v1/map\",status=\"200\"} 1"), std::string::npos)
+      << metrics.body;
+}
+
+// The OpenAPI document lists exactly the routes the router serves, and only those.
+TEST(Router, OpenApiMatchesTheImplementation) {
+  Rig rig;
+  const json api = body(rig.call("GET", "/v1/openapi.json"));
+  EXPECT_EQ(api["openapi"], "3.0.3");
+  std::size_t operations = 0;
+  for (const auto& [path, methods] : api["paths"].items()) {
+    for (const auto& [method, op] : methods.items()) {
+      ++operations;
+      if (path == "/v1/stream") continue;  // served by the transport's upgrade
+      std::string concrete = path;
+      for (const std::string p : {"{id}"}) {
+        const auto at = concrete.find(p);
+        if (at != std::string::npos) concrete.replace(at, p.size(), "1");
+      }
+      std::string upper = method;
+      for (char& c : upper) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+      const auto r = rig.call(upper, concrete, kDispatcher, "{}");
+      EXPECT_NE(r.status, 405) << upper << " " << path;
+      EXPECT_FALSE(r.status == 404 && body(r)["error"]["message"].get<std::string>().rfind("no such endpoint", 0) == 0)
+          << upper << " " << path;
+      EXPECT_TRUE(op.contains("responses")) << path;
+    }
+  }
+  EXPECT_EQ(operations, 14u);
+}
+
+// Random and mutated requests: the router answers every one with a status below 500.
+TEST(Router, FuzzedRequestsNeverCrashOrFailInternally) {
+  Rig rig;
+  std::mt19937_64 rng(99);
+  const std::vector<std::string> targets{"/v1/missions", "/v1/missions/1", "/v1/missions/1/cancel", "/v1/congestion",
+                                         "/v1/vehicles/amb-1/position", "/v1/signals/0/counts", "/v1/signals", "/v1/map",
+                                         "/v1/missions?state=active", "/v1//missions", "/", "/v1/missions/%00"};
+  const std::vector<std::string> seeds{mission_body("amb-9"), R"({"updates":[{"edge":3,"speed_kmh":10,"expires_in_s":5}]})",
+                                       R"({"lat":47.14,"lon":9.52,"timestamp":3,"heading_deg":90,"source":"vo"})",
+                                       R"({"approach":"E","arrivals":2,"departures":1})"};
+  const std::vector<std::string> auths{kDispatcher, kSensor, kViewer, kAmb1, "", "Bearer x"};
+  for (int i = 0; i < 20000; ++i) {
+    std::string text = seeds[rng() % seeds.size()];
+    const int edits = static_cast<int>(rng() % 6);
+    for (int k = 0; k < edits && !text.empty(); ++k) {
+      const std::size_t at = rng() % text.size();
+      switch (rng() % 4) {
+        case 0: text[at] = static_cast<char>(rng() % 256); break;
+        case 1: text.erase(at, 1 + rng() % 5); break;
+        case 2: text.insert(at, std::string(1 + rng() % 3, "{}[]\",:0123456789-.eE"[rng() % 21])); break;
+        default: text.insert(at, "1e308"); break;
+      }
+    }
+    rig.now += 0.01;
+    const auto r = rig.call(rng() % 5 == 0 ? "GET" : "POST", targets[rng() % targets.size()], auths[rng() % auths.size()], text);
+    ASSERT_LT(r.status, 500) << r.body << " for " << text;
+    EXPECT_FALSE(json::parse(r.body, nullptr, false).is_discarded()) << r.body;
+  }
+}
+
+}  // namespace
+}  // namespace corridor::server
