@@ -10,7 +10,9 @@
 #include "app/map_command.hpp"
 #include "app/preemption_command.hpp"
 #include "app/route_command.hpp"
+#include "app/serve_command.hpp"
 #include "maps/errors.hpp"
+#include "server/store.hpp"
 
 int main(int argc, char** argv) {
   // Logs go to stderr so that stdout carries only the command's JSON.
@@ -26,6 +28,7 @@ int main(int argc, char** argv) {
   corridor::app::register_map_command(app);
   corridor::app::register_bench_command(app);
   corridor::app::register_preemption_command(app);
+  corridor::app::register_serve_command(app);
 
   try {
     app.parse(argc, argv);

@@ -14,6 +14,8 @@ nlohmann::json route_to_geojson(const maps::RoadGraph& graph, const Route& route
     const maps::LatLon ll = graph.projection().to_lat_lon(p);
     coordinates.push_back({round7(ll.lon_deg), round7(ll.lat_deg)});
   }
+  nlohmann::json edges = nlohmann::json::array();
+  for (EdgeId e : route.edges) edges.push_back(e.v);
   nlohmann::json nodes = nlohmann::json::array(), osm_nodes = nlohmann::json::array(),
                  arrival = nlohmann::json::array(), signals = nlohmann::json::array();
   for (std::size_t i = 0; i < route.nodes.size(); ++i) {
@@ -30,6 +32,7 @@ nlohmann::json route_to_geojson(const maps::RoadGraph& graph, const Route& route
         {"length_m", route.length_m},
         {"algorithm", algorithm},
         {"nodes", std::move(nodes)},
+        {"edges", std::move(edges)},
         {"osm_nodes", std::move(osm_nodes)},
         {"arrival_s", std::move(arrival)},
         {"signals", std::move(signals)}}},

@@ -8,7 +8,7 @@
 namespace corridor::planner {
 
 // A Feature whose geometry is the route's LineString and whose properties hold travel_time_s,
-// length_m, algorithm, nodes (graph node ids crossed), osm_nodes, arrival_s and signals.
+// length_m, algorithm, nodes (graph node ids crossed), edges, osm_nodes, arrival_s and signals.
 nlohmann::json route_to_geojson(const maps::RoadGraph& graph, const Route& route, const char* algorithm);
 
 }  // namespace corridor::planner

@@ -1,0 +1,106 @@
+#include "app/serve_command.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <random>
+
+#include "app/cli_error.hpp"
+#include "app/map_options.hpp"
+#include "server/dispatch_service.hpp"
+#include "server/http_server.hpp"
+#include "server/router.hpp"
+
+namespace corridor::app {
+namespace {
+
+struct ServeOptions {
+  MapOptions map;
+  std::string db = "corridor.db";
+  std::string listen = "127.0.0.1:8080";
+  std::string config;
+  int threads = 2;
+};
+
+std::string random_token() {
+  std::random_device rd;
+  std::string t;
+  for (int i = 0; i < 32; ++i) t += "0123456789abcdef"[rd() % 16];
+  return t;
+}
+
+nlohmann::json read_config(const std::string& path) {
+  if (path.empty()) return nlohmann::json::object();
+  std::ifstream in(path);
+  if (!in) throw UsageError("config file not found: '" + path + "'");
+  auto j = nlohmann::json::parse(in, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) throw UsageError("config file '" + path + "' is not a JSON object");
+  return j;
+}
+
+void run_serve(const ServeOptions& o) {
+  const auto colon = o.listen.rfind(':');
+  if (colon == std::string::npos) throw UsageError("--listen expects HOST:PORT, got '" + o.listen + "'");
+  const std::string host = o.listen.substr(0, colon);
+  int port = -1;
+  try {
+    port = std::stoi(o.listen.substr(colon + 1));
+  } catch (const std::exception&) {
+  }
+  if (port < 0 || port > 65535) throw UsageError("--listen port must be 0..65535, got '" + o.listen.substr(colon + 1) + "'");
+  if (o.threads < 1 || o.threads > 64) throw UsageError("--threads must be 1..64");
+  const nlohmann::json config = read_config(o.config);
+
+  server::TokenAuth auth;
+  try {
+    auth.add_from_config(config);
+    const char* env = std::getenv("CORRIDOR_DEV_TOKEN");
+    const std::string dev = env != nullptr && *env != '\0' ? std::string(env) : random_token();
+    auth.add(dev, {"development", server::kAllRoles, std::nullopt});
+    std::cout << "development token (all roles): " << dev << std::endl;
+  } catch (const server::AuthConfigError& e) {
+    throw UsageError(e.what());
+  }
+  server::RouterConfig router_config;
+  server::ServerLimits limits;
+  if (auto it = config.find("limits"); it != config.end() && it->is_object()) {
+    router_config.rate_per_token_per_s = it->value("rate_per_token_per_s", router_config.rate_per_token_per_s);
+    router_config.burst_per_token = it->value("burst_per_token", router_config.burst_per_token);
+    limits.body_limit_bytes = it->value("body_limit_bytes", limits.body_limit_bytes);
+    limits.header_limit_bytes = it->value("header_limit_bytes", limits.header_limit_bytes);
+    limits.read_timeout_s = it->value("read_timeout_s", limits.read_timeout_s);
+  }
+
+  const maps::RoadGraph graph = load_map_from_options(o.map);
+  server::Store store(o.db);
+  const auto now = [] {
+    return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+  };
+  server::DispatchService service(graph, {}, &store, now());
+  server::Router router(service, std::move(auth), router_config, now);
+  server::HttpServer http(router, service, limits, host, static_cast<unsigned short>(port), o.threads);
+  std::cout << "listening on http://" << host << ":" << http.port() << " (map: " << graph.node_count() << " nodes, "
+            << service.active_mission_count() << " active missions resumed, db: " << o.db << ")" << std::endl;
+  spdlog::info("event=serving address={}:{} threads={}", host, http.port(), o.threads);
+  http.run();
+  spdlog::info("event=stopped");
+}
+
+}  // namespace
+
+void register_serve_command(CLI::App& app) {
+  auto o = std::make_shared<ServeOptions>();
+  auto* cmd = app.add_subcommand("serve", "Run the dispatch server (HTTP/JSON API and WebSocket stream)");
+  add_map_options(*cmd, o->map);
+  cmd->add_option("--db", o->db, "SQLite database (created if missing)")->capture_default_str();
+  cmd->add_option("--listen", o->listen, "HOST:PORT to listen on (port 0 picks a free one)")->capture_default_str();
+  cmd->add_option("--config", o->config, "JSON config: tokens with roles, limits");
+  cmd->add_option("--threads", o->threads, "I/O threads")->capture_default_str();
+  cmd->callback([o] { run_serve(*o); });
+}
+
+}  // namespace corridor::app

@@ -1,0 +1,272 @@
+#include "server/http_server.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <boost/asio.hpp>
+#include <boost/beast.hpp>
+#include <chrono>
+#include <deque>
+#include <mutex>
+
+#include "server/json_codec.hpp"
+
+namespace corridor::server {
+
+namespace beast = boost::beast;
+namespace http = beast::http;
+namespace websocket = beast::websocket;
+namespace net = boost::asio;
+using tcp = net::ip::tcp;
+
+namespace {
+
+double wall_clock_s() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+class WsSession;
+
+// Fan-out of events to stream clients: weak pointers copied under the lock, sent after it.
+class EventHub {
+ public:
+  void join(const std::shared_ptr<WsSession>& s) {
+    std::lock_guard lock(mutex_);
+    sessions_.push_back(s);
+  }
+  void publish(const std::string& text, MissionId mission);
+
+ private:
+  std::mutex mutex_;
+  std::vector<std::weak_ptr<WsSession>> sessions_;
+};
+
+class WsSession : public std::enable_shared_from_this<WsSession> {
+ public:
+  WsSession(tcp::socket&& socket, EventHub& hub, std::optional<MissionId> filter, std::size_t max_queue)
+      : ws_(std::move(socket)), hub_(hub), filter_(filter), max_queue_(max_queue) {}
+
+  void run(http::request<http::string_body> req) {
+    ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
+    ws_.async_accept(req, beast::bind_front_handler(&WsSession::on_accept, shared_from_this()));
+  }
+
+  void send(std::shared_ptr<const std::string> text, MissionId mission) {
+    if (filter_ && mission != 0 && mission != *filter_) return;
+    if (filter_ && mission == 0) return;  // a mission subscription gets only that mission's events
+    net::post(ws_.get_executor(), [self = shared_from_this(), text] { self->queue(text); });
+  }
+
+ private:
+  void on_accept(beast::error_code ec) {
+    if (ec) return;
+    hub_.join(shared_from_this());
+    auto hello = std::make_shared<const std::string>(R"({"type":"hello"})");
+    queue(hello);
+    read();
+  }
+  void read() { ws_.async_read(in_, beast::bind_front_handler(&WsSession::on_read, shared_from_this())); }
+  void on_read(beast::error_code ec, std::size_t) {
+    if (ec) return;  // closed: the hub forgets expired sessions
+    in_.consume(in_.size());
+    read();
+  }
+  void queue(std::shared_ptr<const std::string> text) {
+    if (closed_) return;
+    if (out_.size() >= max_queue_) {
+      // A client that cannot keep up is dropped rather than buffered without bound.
+      closed_ = true;
+      ws_.async_close(websocket::close_code::policy_error, [self = shared_from_this()](beast::error_code) {});
+      return;
+    }
+    out_.push_back(std::move(text));
+    if (out_.size() == 1) write();
+  }
+  void write() {
+    ws_.text(true);
+    ws_.async_write(net::buffer(*out_.front()), beast::bind_front_handler(&WsSession::on_write, shared_from_this()));
+  }
+  void on_write(beast::error_code ec, std::size_t) {
+    if (ec) {
+      closed_ = true;
+      return;
+    }
+    out_.pop_front();
+    if (!out_.empty()) write();  // one outstanding async_write at a time
+  }
+
+  websocket::stream<beast::tcp_stream> ws_;
+  beast::flat_buffer in_;
+  std::deque<std::shared_ptr<const std::string>> out_;
+  EventHub& hub_;
+  std::optional<MissionId> filter_;
+  std::size_t max_queue_;
+  bool closed_ = false;
+};
+
+void EventHub::publish(const std::string& text, MissionId mission) {
+  std::vector<std::shared_ptr<WsSession>> live;
+  {
+    std::lock_guard lock(mutex_);
+    std::erase_if(sessions_, [](const auto& w) { return w.expired(); });
+    for (const auto& w : sessions_) {
+      if (auto s = w.lock()) live.push_back(std::move(s));
+    }
+  }
+  auto shared = std::make_shared<const std::string>(text);
+  for (const auto& s : live) s->send(shared, mission);
+}
+
+class HttpSession : public std::enable_shared_from_this<HttpSession> {
+ public:
+  HttpSession(tcp::socket&& socket, Router& router, EventHub& hub, const ServerLimits& limits)
+      : stream_(std::move(socket)), router_(router), hub_(hub), limits_(limits) {}
+
+  void run() { net::dispatch(stream_.get_executor(), beast::bind_front_handler(&HttpSession::read, shared_from_this())); }
+
+ private:
+  void read() {
+    parser_.emplace();
+    parser_->body_limit(limits_.body_limit_bytes);
+    parser_->header_limit(static_cast<std::uint32_t>(limits_.header_limit_bytes));
+    stream_.expires_after(std::chrono::seconds(limits_.read_timeout_s));
+    http::async_read(stream_, buffer_, *parser_, beast::bind_front_handler(&HttpSession::on_read, shared_from_this()));
+  }
+
+  void on_read(beast::error_code ec, std::size_t) {
+    if (ec == http::error::end_of_stream || ec == beast::error::timeout) return close();
+    if (ec == http::error::body_limit) return reply_error(413, "payload_too_large", "request body exceeds the limit", false);
+    if (ec == http::error::header_limit) return reply_error(431, "headers_too_large", "request headers exceed the limit", false);
+    if (ec) return reply_error(400, "bad_request", "malformed HTTP request", false);
+    auto req = parser_->release();
+    const std::string target(req.target());
+    if (websocket::is_upgrade(req)) {
+      if (target.rfind("/v1/stream", 0) != 0) return reply_error(404, "not_found", "WebSocket is served on /v1/stream", false);
+      if (!router_.authorize_stream(std::string(req[http::field::authorization]))) {
+        return reply_error(401, "unauthorized", "a viewer or dispatcher token is required for the stream", false);
+      }
+      std::optional<MissionId> filter;
+      if (const auto q = target.find("mission="); q != std::string::npos) {
+        try {
+          filter = std::stoull(target.substr(q + 8));
+        } catch (const std::exception&) {
+          return reply_error(400, "bad_request", "mission must be a mission id", false);
+        }
+      }
+      stream_.expires_never();
+      std::make_shared<WsSession>(stream_.release_socket(), hub_, filter, limits_.max_queued_events)->run(std::move(req));
+      return;
+    }
+    const HttpResponse r = router_.handle({std::string(req.method_string()), target,
+                                           std::string(req[http::field::authorization]), std::move(req.body())});
+    respond(r.status, r.content_type, r.body, req.keep_alive());
+  }
+
+  void reply_error(int status, const std::string& code, const std::string& message, bool keep_alive) {
+    respond(status, "application/json", error_json(code, message).dump(), keep_alive);
+  }
+
+  void respond(int status, const std::string& content_type, std::string body, bool keep_alive) {
+    auto res = std::make_shared<http::response<http::string_body>>(static_cast<http::status>(status), 11);
+    res->set(http::field::server, "corridor");
+    res->set(http::field::content_type, content_type);
+    res->keep_alive(keep_alive);
+    res->body() = std::move(body);
+    res->prepare_payload();
+    response_ = res;
+    http::async_write(stream_, *res, beast::bind_front_handler(&HttpSession::on_write, shared_from_this(), keep_alive));
+  }
+
+  void on_write(bool keep_alive, beast::error_code ec, std::size_t) {
+    response_.reset();
+    if (ec || !keep_alive) return close();
+    read();
+  }
+
+  void close() {
+    beast::error_code ec;
+    stream_.socket().shutdown(tcp::socket::shutdown_send, ec);
+  }
+
+  beast::tcp_stream stream_;
+  beast::flat_buffer buffer_;
+  std::optional<http::request_parser<http::string_body>> parser_;
+  std::shared_ptr<http::response<http::string_body>> response_;
+  Router& router_;
+  EventHub& hub_;
+  const ServerLimits& limits_;
+};
+
+}  // namespace
+
+struct HttpServer::Impl {
+  Impl(Router& r, DispatchService& s, ServerLimits l, int n)
+      : router(r), service(s), limits(l), threads(std::max(1, n)), ioc(threads), acceptor(net::make_strand(ioc)),
+        signals(ioc, SIGINT, SIGTERM), ticker(ioc) {}
+
+  void accept() {
+    acceptor.async_accept(net::make_strand(ioc), [this](beast::error_code ec, tcp::socket socket) {
+      if (!ec) std::make_shared<HttpSession>(std::move(socket), router, hub, limits)->run();
+      if (acceptor.is_open()) accept();
+    });
+  }
+  void tick() {
+    ticker.expires_after(std::chrono::seconds(1));
+    ticker.async_wait([this](beast::error_code ec) {
+      if (ec) return;
+      try {
+        service.tick(wall_clock_s());
+      } catch (const std::exception& e) {
+        spdlog::error("event=tick_failed error=\"{}\"", e.what());
+      }
+      tick();
+    });
+  }
+
+  Router& router;
+  DispatchService& service;
+  ServerLimits limits;
+  int threads;
+  net::io_context ioc;
+  tcp::acceptor acceptor;
+  net::signal_set signals;
+  net::steady_timer ticker;
+  EventHub hub;
+};
+
+HttpServer::HttpServer(Router& router, DispatchService& service, ServerLimits limits, const std::string& address,
+                       unsigned short port, int threads)
+    : impl_(std::make_unique<Impl>(router, service, limits, threads)) {
+  const tcp::endpoint endpoint{net::ip::make_address(address), port};
+  impl_->acceptor.open(endpoint.protocol());
+  impl_->acceptor.set_option(net::socket_base::reuse_address(true));
+  impl_->acceptor.bind(endpoint);
+  impl_->acceptor.listen(net::socket_base::max_listen_connections);
+  service.subscribe([hub = &impl_->hub](const DispatchEvent& e) { hub->publish(event_to_json(e).dump(), e.mission); });
+}
+
+HttpServer::~HttpServer() { stop(); }
+
+unsigned short HttpServer::port() const { return impl_->acceptor.local_endpoint().port(); }
+
+void HttpServer::run() {
+  impl_->accept();
+  impl_->tick();
+  impl_->signals.async_wait([this](beast::error_code, int) { stop(); });
+  std::vector<std::thread> pool;
+  for (int i = 1; i < impl_->threads; ++i) pool.emplace_back([this] { impl_->ioc.run(); });
+  impl_->ioc.run();
+  for (auto& t : pool) t.join();
+}
+
+void HttpServer::stop() {
+  if (!impl_) return;
+  net::post(impl_->ioc, [impl = impl_.get()] {
+    beast::error_code ec;
+    impl->acceptor.close(ec);
+    impl->ticker.cancel();
+    impl->signals.cancel();
+  });
+  impl_->ioc.stop();
+}
+
+}  // namespace corridor::server
