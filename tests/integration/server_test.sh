@@ -52,9 +52,17 @@ check "token never in logs" "! grep -q '$TOKEN' '$work/serve.err'"
 check "health" "[[ \$(api GET /v1/health) == 200 ]]"
 
 # A WebSocket client listens for the whole scenario.
-python3 "$here/ws_listen.py" 127.0.0.1 "$port" viewer-token-0123456789abcdef 8 > "$work/ws.txt" &
+python3 "$here/ws_listen.py" 127.0.0.1 "$port" viewer-token-0123456789abcdef 120 > "$work/ws.txt" &
 ws_pid=$!
-sleep 0.5
+wait_for() {  # SECONDS CONDITION: polls instead of sleeping a fixed time (CI machines are shared)
+  local deadline=$((SECONDS + $1))
+  while ((SECONDS < deadline)); do
+    eval "$2" && return 0
+    sleep 0.1
+  done
+  return 1
+}
+wait_for 20 "grep -q '\"type\":\"hello\"' '$work/ws.txt'" || fail "stream did not open"
 
 # 1. Create a mission across Monaco.
 status=$(api POST /v1/missions '{"vehicle_id":"amb-1","origin":{"lat":43.7384,"lon":7.4246},"destination":{"lat":43.7496,"lon":7.4365},"priority":2}')
@@ -85,7 +93,9 @@ check "mission completes at the destination" "[[ $status == 200 && \$(jq_py \"d[
 api GET "/v1/missions/$mission" > /dev/null
 check "mission state completed" "[[ \$(jq_py \"d['state']\") == completed ]]"
 
-wait $ws_pid
+wait_for 30 "grep -q '\"type\":\"mission_completed\"' '$work/ws.txt'"
+kill $ws_pid 2> /dev/null
+wait $ws_pid 2> /dev/null
 check "stream handshake" "grep -q 'STATUS HTTP/1.1 101' '$work/ws.txt'"
 for kind in mission_created route_changed position congestion_applied mission_completed; do
   check "stream received $kind" "grep -q '\"type\":\"$kind\"' '$work/ws.txt'"
@@ -118,7 +128,7 @@ resumed_id=$(jq_py "d['id']")
   done
 ) &
 load_pid=$!
-sleep 1.5
+wait_for 60 "[[ \$(wc -l < '$work/acked.txt') -ge 50 ]]"
 kill -9 "$server_pid"
 wait "$server_pid" 2> /dev/null
 server_pid=""
