@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
-# Set-up, build and the main job. Until the server lands, the main job is a route on the embedded map.
+# Set-up, build and the main job: the dispatch server on the embedded Monaco map, on
+# 127.0.0.1:8080, with its database in ./corridor.db. It prints a development token at start
+# (fixed by CORRIDOR_DEV_TOKEN when set). Extra arguments go to `corridor serve`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
 cmake --preset default
 cmake --build --preset default -j2 --target corridor
-exec ./build/app/corridor route --from 43.7384,7.4246 --to 43.7496,7.4365 "$@"
+exec ./build/app/corridor serve "$@"
