@@ -7,6 +7,7 @@
 #include "app/cli_error.hpp"
 #include "app/map_options.hpp"
 #include "bench/replan_bench.hpp"
+#include "bench/serve_bench.hpp"
 #include "maps/synthetic_grid.hpp"
 
 namespace corridor::app {
@@ -63,6 +64,23 @@ void register_bench_command(CLI::App& app) {
   replan->add_option("--min-trip-m", o->config.min_trip_m, "minimum straight-line trip length (0 = auto)");
   replan->add_flag("!--no-dijkstra", o->config.run_dijkstra, "skip the Dijkstra baseline (and the mismatch check)");
   replan->callback([o] { run_replan(*o); });
+
+  auto s = std::make_shared<std::pair<MapOptions, bench::ServeBenchConfig>>();
+  auto* serve = bench_cmd->add_subcommand("serve", "Load on the HTTP server over loopback: positions and congestion");
+  add_map_options(*serve, s->first);
+  serve->add_option("--vehicles", s->second.vehicles, "vehicles posting positions")->capture_default_str();
+  serve->add_option("--missions", s->second.missions, "of which with an active mission")->capture_default_str();
+  serve->add_option("--congestion-edges-per-s", s->second.congestion_edges_per_s, "congested edges per second")
+      ->capture_default_str();
+  serve->add_option("--seconds", s->second.seconds, "duration of the load")->capture_default_str();
+  serve->add_option("--client-threads", s->second.client_threads, "load generator threads")->capture_default_str();
+  serve->add_option("--server-threads", s->second.server_threads, "server I/O threads")->capture_default_str();
+  serve->callback([s] {
+    const maps::RoadGraph graph = load_map_from_options(s->first);
+    auto out = bench::run_serve_bench(graph, s->second);
+    out["map"] = s->first.map_file.empty() ? "embedded monaco.osm.gz" : s->first.map_file;
+    std::cout << out.dump(2) << '\n';
+  });
 }
 
 }  // namespace corridor::app

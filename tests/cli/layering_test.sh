@@ -10,7 +10,7 @@ declare -A allowed=(
   [sim]="maps planner preemption sim"
   [server]="maps planner preemption server"
   [localizer]="maps localizer"
-  [bench]="maps planner preemption bench"
+  [bench]="maps planner preemption server bench"
 )
 violations=0
 checked=0
