@@ -141,6 +141,8 @@ void PreemptionEngine::arbitrate(NodeId node, double now_s) {
     for (bool moved = true; moved;) {
       moved = false;
       for (const ScheduleEntry* a : accepted) {
+        // A hold already on keeps the junction until the higher claim's own start comes.
+        if (e->state == EntryState::active && a->start_s > now_s) continue;
         const bool overlap = e->start_s < a->release_s && a->start_s < e->release_s;
         if (overlap && phases_conflict(plan, e->phase, a->phase)) {
           e->start_s = a->release_s + plan.yellow_s + plan.all_red_s;
@@ -240,6 +242,7 @@ void PreemptionEngine::update_route(MissionId mission, int priority, std::span<c
   std::vector<NodeId> on_route;
   for (const Crossing& c : crossings) {
     if (plans_.count(c.node) == 0 || std::find(on_route.begin(), on_route.end(), c.node) != on_route.end()) continue;
+    if (exhausted_.count({mission, c.node}) != 0) continue;
     on_route.push_back(c.node);
     ScheduleEntry* existing = nullptr;
     for (auto& e : entries) {
@@ -328,7 +331,12 @@ void PreemptionEngine::tick(double now_s) {
       if (now_s > e->arrival_s + config_.max_overrun_s) {
         finish(*e, EntryState::expired, now_s, "reason=vehicle_overdue");
       } else if (e->state == EntryState::active && now_s > e->started_s + config_.max_hold_s) {
+        exhausted_.insert({e->mission, e->node});
         finish(*e, EntryState::expired, now_s, "reason=max_hold");
+      } else if (e->state == EntryState::active && now_s > e->release_s + config_.release_grace_s) {
+        // Re-timed on every replan, release_s runs ahead of a vehicle that reports; one that went
+        // silent after the junction does not keep it.
+        finish(*e, EntryState::expired, now_s, "reason=release_time_passed");
       }
     }
     arbitrate(node, now_s);

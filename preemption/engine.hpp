@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <optional>
 #include <map>
+#include <set>
 #include <memory>
 #include <span>
 #include <string>
@@ -32,6 +33,7 @@ struct PreemptionConfig {
   double release_after_arrival_s = 8.0;  // planned release: the vehicle is through the junction
   double max_overrun_s = 60.0;           // a vehicle this late past its predicted arrival: expire
   double max_hold_s = 180.0;             // no hold lasts longer than this, whatever happens
+  double release_grace_s = 15.0;         // an active hold this long past its planned release ends
 };
 
 // One signalized intersection on a route.
@@ -122,6 +124,9 @@ class PreemptionEngine {
   std::unordered_map<NodeId, QueueEstimator> queues_;
   std::unordered_map<NodeId, std::array<ApproachMeasurement, 4>> measurements_;
   std::vector<PreemptionEvent> events_;
+  // (mission, signal) pairs whose hold hit max_hold_s: never held again for that mission, so a
+  // stuck vehicle cannot keep a junction by re-scheduling.
+  std::set<std::pair<MissionId, NodeId>> exhausted_;
 };
 
 }  // namespace corridor::preemption

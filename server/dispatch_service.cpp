@@ -76,14 +76,20 @@ DispatchService::DispatchService(const maps::RoadGraph& graph, DispatchConfig co
 
 DispatchService::~DispatchService() = default;
 
-void DispatchService::subscribe(Listener listener) {
+std::size_t DispatchService::subscribe(Listener listener) {
   std::lock_guard lock(mutex_);
-  listeners_.push_back(std::move(listener));
+  listeners_[next_listener_] = std::move(listener);
+  return next_listener_++;
+}
+
+void DispatchService::unsubscribe(std::size_t id) {
+  std::lock_guard lock(mutex_);
+  listeners_.erase(id);
 }
 
 void DispatchService::emit(const std::string& kind, MissionId mission, const std::string& reason, double now_s) {
   const DispatchEvent event{kind, mission, reason, now_s};
-  for (const auto& l : listeners_) l(event);
+  for (const auto& [id, l] : listeners_) l(event);
 }
 
 std::vector<planner::EdgePoint> DispatchService::endpoints(const maps::SnapResult& s, Role role,
@@ -132,14 +138,17 @@ void DispatchService::drain_preemption_events() {
   }
 }
 
-void DispatchService::publish_route(Mission& m, const std::string& reason, double now_s) {
-  ++m.revision;
-  m.row.updated_s = now_s;
+void DispatchService::persist_route(Mission& m, const std::string& reason, double now_s) {
   if (store_ != nullptr) {
     const auto feature = planner::route_to_geojson(graph_, m.route, "dstar");
-    store_->insert_route_revision(m.row.id, m.revision, reason, m.route.travel_time_s, m.route.length_m,
+    store_->insert_route_revision(m.row.id, m.revision + 1, reason, m.route.travel_time_s, m.route.length_m,
                                   feature["geometry"].dump(), now_s);
   }
+  ++m.revision;
+  m.row.updated_s = now_s;
+}
+
+void DispatchService::announce_route(Mission& m, const std::string& reason, double now_s) {
   const auto crossings = preemption::signalized_crossings(m.route, plans_, now_s);
   preemption_.update_route(m.row.id, m.row.priority, crossings, now_s);
   emit(m.revision == 1 ? "mission_created" : "route_changed", m.row.id, reason, now_s);
@@ -186,21 +195,20 @@ MissionView DispatchService::create_mission(const MissionRequest& req, double no
   m->route = m->planner->route();
   if (!m->route.found) throw unprocessable("unreachable", "the destination cannot be reached from the origin");
 
+  // The database first: if it fails, nothing was shared and the request fails whole.
   if (store_ != nullptr) {
     Store::Transaction tx(*store_);
     m->row.id = store_->insert_mission(m->row);
-    Mission& ref = *m;
-    missions_[ref.row.id] = std::move(m);
-    active_by_vehicle_[ref.row.vehicle_id] = ref.row.id;
-    publish_route(ref, "dispatch", now_s);
+    persist_route(*m, "dispatch", now_s);
     tx.commit();
-    return view(ref);
+  } else {
+    m->row.id = next_memory_id_++;
+    persist_route(*m, "dispatch", now_s);
   }
-  m->row.id = next_memory_id_++;
   Mission& ref = *m;
   missions_[ref.row.id] = std::move(m);
   active_by_vehicle_[ref.row.vehicle_id] = ref.row.id;
-  publish_route(ref, "dispatch", now_s);
+  announce_route(ref, "dispatch", now_s);
   return view(ref);
 }
 
@@ -230,9 +238,9 @@ DispatchService::Mission& DispatchService::active(MissionId id) {
 }
 
 void DispatchService::finish(Mission& m, MissionState state, double now_s) {
+  if (store_ != nullptr) store_->update_mission_state(m.row.id, state, now_s);  // may throw: nothing changed yet
   m.row.state = state;
   m.row.updated_s = now_s;
-  if (store_ != nullptr) store_->update_mission_state(m.row.id, state, now_s);
   active_by_vehicle_.erase(m.row.vehicle_id);
   preemption_.cancel(m.row.id, now_s);
   m.planner.reset();  // a finished mission keeps its last route, not its search state
@@ -355,41 +363,55 @@ CongestionResult DispatchService::report_congestion(const std::vector<Congestion
       throw bad_request("travel_time_s must be a positive number of seconds");
     }
     if (u.factor && !(*u.factor > 0.0) ) throw bad_request("factor must be positive (a very large factor closes the road)");
-    for (EdgeId e : resolve_edges(u)) {
-      const double free_flow_s = graph_.length_m(e) / graph_.speed_mps(e);
+    const std::vector<EdgeId> edges = resolve_edges(u);
+    // travel_time_s is the time of the whole edge or way (each road counted once, not per direction).
+    double free_flow_s = 0.0;
+    for (EdgeId e : edges) {
+      if (!graph_.twin(e).valid() || e < graph_.twin(e) || edges.size() == 1) free_flow_s += graph_.length_m(e) / graph_.speed_mps(e);
+    }
+    for (EdgeId e : edges) {
       double factor = 1.0;
       if (u.factor) factor = *u.factor;
       if (u.speed_kmh) factor = *u.speed_kmh <= 0.0 ? planner::kInfCost : (graph_.speed_mps(e) * 3.6) / *u.speed_kmh;
-      // An osm_way_id update gives the time of the whole way; spread it by edge length.
       if (u.travel_time_s) factor = *u.travel_time_s / free_flow_s;
-      changes.push_back({e, {factor, overlay_.edge(e).queue_delay_s}});
+      changes.push_back({e, {factor, 0.0}});
       expiry.push_back(u.expires_in_s ? std::optional<double>(now_s + *u.expires_in_s) : std::nullopt);
     }
   }
 
   std::lock_guard lock(mutex_);
-  std::optional<Store::Transaction> tx;
-  if (store_ != nullptr) tx.emplace(*store_);
+  // A speed or factor update keeps the edge's queue delay; read it under the lock.
+  for (auto& [e, condition] : changes) condition.queue_delay_s = overlay_.edge(e).queue_delay_s;
+  // Persist the whole batch before applying any of it, so a storage failure changes nothing.
+  if (store_ != nullptr) {
+    Store::Transaction tx(*store_);
+    for (std::size_t i = 0; i < changes.size(); ++i) store_->insert_congestion(changes[i].first, changes[i].second, expiry[i], now_s);
+    tx.commit();
+  }
   std::vector<EdgeId> changed;
   for (std::size_t i = 0; i < changes.size(); ++i) {
     overlay_.set_edge(changes[i].first, changes[i].second);
     changed.push_back(changes[i].first);
-    if (store_ != nullptr) store_->insert_congestion(changes[i].first, changes[i].second, expiry[i], now_s);
-    if (expiry[i]) expiries_.emplace(*expiry[i], changes[i].first);
+    const std::uint64_t seq = ++update_sequence_;
+    latest_update_[changes[i].first] = seq;
+    if (expiry[i]) expiries_.emplace(*expiry[i], std::make_pair(changes[i].first, seq));
   }
   CongestionResult result = replan_all(changed, "congestion", now_s);
   emit("congestion_applied", 0, std::to_string(changed.size()) + " edges", now_s);
-  if (tx) tx->commit();
   return result;
 }
 
 CongestionResult DispatchService::replan_all(const std::vector<EdgeId>& changed, const std::string& reason, double now_s) {
   CongestionResult result;
   result.edges_changed = changed.size();
+  // Every planner hears of every change before any replan can fail on storage: D* Lite must be
+  // told of each change exactly once.
+  for (auto& [id, m] : missions_) {
+    if (m->row.state == MissionState::active) m->planner->edges_changed(changed);
+  }
   for (auto& [id, m] : missions_) {
     if (m->row.state != MissionState::active) continue;
     const std::vector<EdgeId> before = m->route.edges;
-    m->planner->edges_changed(changed);
     m->planner->replan();
     m->route = m->planner->route();
     ++result.missions_replanned;
@@ -419,12 +441,11 @@ void DispatchService::tick(double now_s) {
   std::lock_guard lock(mutex_);
   std::vector<EdgeId> expired;
   while (!expiries_.empty() && expiries_.begin()->first <= now_s) {
-    const EdgeId e = expiries_.begin()->second;
+    const auto [e, seq] = expiries_.begin()->second;
     expiries_.erase(expiries_.begin());
-    // Only if no later update re-congested the edge with a later expiry or none.
-    bool superseded = false;
-    for (const auto& [t, edge] : expiries_) superseded = superseded || edge == e;
-    if (superseded) continue;
+    // An expiry ends only the update it came with; a later update of the edge stays in force.
+    if (latest_update_[e] != seq) continue;
+    latest_update_.erase(e);
     overlay_.reset_edge(e);
     expired.push_back(e);
   }
@@ -449,7 +470,9 @@ void DispatchService::restore(double now_s) {
   for (const CongestionRow& c : store_->congestion_in_force(now_s)) {
     if (c.edge.index() >= graph_.edge_count()) continue;  // recorded against another map
     overlay_.set_edge(c.edge, c.condition);
-    if (c.expires_at_s) expiries_.emplace(*c.expires_at_s, c.edge);
+    const std::uint64_t seq = ++update_sequence_;
+    latest_update_[c.edge] = seq;
+    if (c.expires_at_s) expiries_.emplace(*c.expires_at_s, std::make_pair(c.edge, seq));
   }
   for (const MissionRow& row : store_->missions(std::nullopt)) {
     const auto last = store_->last_position(row.vehicle_id);

@@ -48,7 +48,9 @@ class DispatchService {
   // Expires congestion and drives the signals; call about once a second.
   void tick(double now_s);
 
-  void subscribe(Listener listener);
+  // Returns an id for unsubscribe(); a listener must be removed before it is destroyed.
+  std::size_t subscribe(Listener listener);
+  void unsubscribe(std::size_t id);
   [[nodiscard]] const maps::RoadGraph& graph() const { return graph_; }
   [[nodiscard]] const std::unordered_map<NodeId, maps::SignalPlan>& signal_plans() const { return plans_; }
   [[nodiscard]] std::vector<preemption::Light> signal_lights(NodeId node) const;
@@ -60,7 +62,14 @@ class DispatchService {
   Mission& active(MissionId id);
   enum class Role { start, goal };
   std::vector<planner::EdgePoint> endpoints(const maps::SnapResult& snap, Role role, std::optional<double> heading_deg) const;
-  void publish_route(Mission& m, const std::string& reason, double now_s);
+  // A new route revision: persist_route writes it (may throw StoreError, before anything is
+  // shared); announce_route re-times the signals and tells the listeners.
+  void persist_route(Mission& m, const std::string& reason, double now_s);
+  void announce_route(Mission& m, const std::string& reason, double now_s);
+  void publish_route(Mission& m, const std::string& reason, double now_s) {
+    persist_route(m, reason, now_s);
+    announce_route(m, reason, now_s);
+  }
   // Repairs every active mission's plan after `changed` edges changed cost; publishes new routes.
   CongestionResult replan_all(const std::vector<EdgeId>& changed, const std::string& reason, double now_s);
   void drain_preemption_events();
@@ -82,8 +91,13 @@ class DispatchService {
   std::map<MissionId, std::unique_ptr<Mission>> missions_;
   std::unordered_map<std::string, MissionId> active_by_vehicle_;
   std::unordered_map<std::string, maps::LatLon> last_position_;
-  std::multimap<double, EdgeId> expiries_;
-  std::vector<Listener> listeners_;
+  // Expiry time -> (edge, update sequence); an expiry resets the edge only if it belongs to the
+  // edge's latest update.
+  std::multimap<double, std::pair<EdgeId, std::uint64_t>> expiries_;
+  std::unordered_map<EdgeId, std::uint64_t> latest_update_;
+  std::uint64_t update_sequence_ = 0;
+  std::map<std::size_t, Listener> listeners_;
+  std::size_t next_listener_ = 1;
   MissionId next_memory_id_ = 1;
   mutable std::mutex mutex_;
 };

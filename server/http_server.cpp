@@ -201,12 +201,22 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
 struct HttpServer::Impl {
   Impl(Router& r, DispatchService& s, ServerLimits l, int n)
       : router(r), service(s), limits(l), threads(std::max(1, n)), ioc(threads), acceptor(net::make_strand(ioc)),
-        signals(ioc, SIGINT, SIGTERM), ticker(ioc) {}
+        signals(ioc, SIGINT, SIGTERM), ticker(ioc), accept_retry(ioc) {}
 
   void accept() {
     acceptor.async_accept(net::make_strand(ioc), [this](beast::error_code ec, tcp::socket socket) {
-      if (!ec) std::make_shared<HttpSession>(std::move(socket), router, hub, limits)->run();
-      if (acceptor.is_open()) accept();
+      if (!acceptor.is_open()) return;
+      if (!ec) {
+        std::make_shared<HttpSession>(std::move(socket), router, hub, limits)->run();
+        accept();
+        return;
+      }
+      // Out of file descriptors and the like: back off instead of spinning a core.
+      spdlog::warn("event=accept_failed error=\"{}\"", ec.message());
+      accept_retry.expires_after(std::chrono::milliseconds(100));
+      accept_retry.async_wait([this](beast::error_code wait_ec) {
+        if (!wait_ec) accept();
+      });
     });
   }
   void tick() {
@@ -230,7 +240,9 @@ struct HttpServer::Impl {
   tcp::acceptor acceptor;
   net::signal_set signals;
   net::steady_timer ticker;
+  net::steady_timer accept_retry;
   EventHub hub;
+  std::size_t subscription = 0;
 };
 
 HttpServer::HttpServer(Router& router, DispatchService& service, ServerLimits limits, const std::string& address,
@@ -241,10 +253,14 @@ HttpServer::HttpServer(Router& router, DispatchService& service, ServerLimits li
   impl_->acceptor.set_option(net::socket_base::reuse_address(true));
   impl_->acceptor.bind(endpoint);
   impl_->acceptor.listen(net::socket_base::max_listen_connections);
-  service.subscribe([hub = &impl_->hub](const DispatchEvent& e) { hub->publish(event_to_json(e).dump(), e.mission); });
+  impl_->subscription =
+      service.subscribe([hub = &impl_->hub](const DispatchEvent& e) { hub->publish(event_to_json(e).dump(), e.mission); });
 }
 
-HttpServer::~HttpServer() { stop(); }
+HttpServer::~HttpServer() {
+  stop();
+  impl_->service.unsubscribe(impl_->subscription);  // the hub dies with this server
+}
 
 unsigned short HttpServer::port() const { return impl_->acceptor.local_endpoint().port(); }
 
@@ -264,6 +280,7 @@ void HttpServer::stop() {
     beast::error_code ec;
     impl->acceptor.close(ec);
     impl->ticker.cancel();
+    impl->accept_retry.cancel();
     impl->signals.cancel();
   });
   impl_->ioc.stop();

@@ -64,7 +64,7 @@ json map_feature_collection(const maps::RoadGraph& g) {
 Router::Router(DispatchService& service, TokenAuth auth, RouterConfig config, Clock clock)
     : service_(service), auth_(std::move(auth)), config_(config), clock_(std::move(clock)) {
   map_geojson_ = map_feature_collection(service_.graph()).dump();
-  service_.subscribe([this](const DispatchEvent& e) {
+  subscription_ = service_.subscribe([this](const DispatchEvent& e) {
     if (e.kind == "route_changed") metrics_.count("route_changes_total");
     if (e.kind.rfind("preemption_", 0) == 0) metrics_.count(e.kind + "_total");
   });
@@ -172,6 +172,8 @@ Router::Router(DispatchService& service, TokenAuth auth, RouterConfig config, Cl
     return json_response(200, signal_json(it->first, it->second));
   });
 }
+
+Router::~Router() { service_.unsubscribe(subscription_); }
 
 void Router::add(std::string method, std::string pattern, std::uint8_t roles, std::string summary, Handler handler) {
   routes_.push_back({std::move(method), std::move(pattern), roles, std::move(summary), std::move(handler)});

@@ -41,6 +41,9 @@ class Router {
   using Clock = std::function<double()>;  // seconds; wall clock in production, fake in tests
 
   Router(DispatchService& service, TokenAuth auth, RouterConfig config, Clock clock);
+  ~Router();
+  Router(const Router&) = delete;
+  Router& operator=(const Router&) = delete;
 
   HttpResponse handle(const HttpRequest& request) noexcept;
   // For the WebSocket upgrade: the principal if it may read the stream.
@@ -75,6 +78,7 @@ class Router {
   std::string map_geojson_;  // rendered once: the graph never changes
   std::mutex buckets_mutex_;
   std::unordered_map<std::string, std::pair<double, double>> buckets_;  // token -> (tokens left, last refill)
+  std::size_t subscription_ = 0;
 };
 
 }  // namespace corridor::server

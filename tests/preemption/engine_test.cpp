@@ -119,12 +119,17 @@ TEST(PreemptionEngine, VehicleThatNeverArrivesExpiresAndTheSignalRecovers) {
   Rig rig;
   const std::vector<Crossing> route{rig.crossing(kS, kN, 40.0)};
   rig.engine.update_route(7, 1, route, 0.0);
-  for (double t = 0; t <= 40.0 + 60.0; t += 1.0) rig.run_until(t);
-  EXPECT_TRUE(rig.engine.holding(rig.c));  // still waiting within the allowed overrun
-  rig.run_until(101.0);
+  // Planned release is arrival + 8 s; with no report since, the hold ends 15 s after that.
+  for (double t = 0; t <= 40.0 + 8.0 + 15.0; t += 1.0) rig.run_until(t);
+  EXPECT_TRUE(rig.engine.holding(rig.c));  // still waiting within the grace
+  rig.run_until(64.0);
   EXPECT_EQ(rig.engine.schedule(7)[0].state, EntryState::expired);
   EXPECT_FALSE(rig.engine.holding(rig.c));
-  rig.run_until(101.0 + 5.0 + 2 * (3.0 + 2.0));
+  const auto events = rig.engine.take_events();
+  EXPECT_TRUE(std::any_of(events.begin(), events.end(), [](const PreemptionEvent& e) {
+    return e.kind == "expired" && e.detail == "reason=release_time_passed";
+  }));
+  rig.run_until(64.0 + 5.0 + 2 * (3.0 + 2.0));
   EXPECT_TRUE(rig.controller.running_program(rig.c));
   EXPECT_TRUE(rig.monitor.violations().empty());
 }
@@ -269,6 +274,47 @@ TEST(PreemptionEngine, OccupancyOrSpeedRatioClassifyCongestionWithoutQueueData) 
   EXPECT_EQ(rig.engine.schedule(2)[0].congestion, CongestionLevel::low);
   EXPECT_THROW(rig.engine.record_measurement(rig.c, maps::Compass::west, 1.5, std::nullopt), CountError);
   EXPECT_THROW(rig.engine.record_measurement(NodeId{99}, maps::Compass::west, 0.1, std::nullopt), CountError);
+}
+
+// A vehicle stuck before the junction keeps reporting, so its arrival keeps moving out: the hold
+// still ends at max_hold_s, and that vehicle is never given this junction again.
+TEST(PreemptionEngine, MaxHoldCannotBeRenewedByReScheduling) {
+  Rig rig;
+  double t = 0.0;
+  for (; t <= 200.0; t += 1.0) {
+    const std::vector<Crossing> route{rig.crossing(kE, kW, t + 5.0)};  // always 5 s away
+    rig.engine.update_route(1, 1, route, t);
+    rig.run_until(t);
+    if (t > 6.0 && t < 180.0) {
+      ASSERT_TRUE(rig.engine.holding(rig.c)) << t;
+    }
+  }
+  EXPECT_FALSE(rig.engine.holding(rig.c));
+  for (; t <= 260.0; t += 1.0) {
+    const std::vector<Crossing> route{rig.crossing(kE, kW, t + 5.0)};
+    rig.engine.update_route(1, 1, route, t);
+    rig.run_until(t);
+    ASSERT_FALSE(rig.engine.holding(rig.c)) << t;
+  }
+  EXPECT_TRUE(rig.monitor.violations().empty());
+}
+
+// A lower-priority vehicle already holding keeps the junction until the higher-priority claim's
+// own start time, rather than losing it the moment that claim is scheduled.
+TEST(PreemptionEngine, ActiveHoldIsKeptUntilTheHigherClaimStarts) {
+  Rig rig;
+  const std::vector<Crossing> low{rig.crossing(kN, kS, 12.0)};
+  rig.engine.update_route(1, 1, low, 0.0);
+  rig.run_until(9.0);
+  ASSERT_EQ(rig.engine.schedule(1)[0].state, EntryState::active);
+  const std::vector<Crossing> high{rig.crossing(kE, kW, 40.0)};  // starts at about 27 s
+  rig.engine.update_route(2, 5, high, 9.5);
+  rig.run_until(10.0);
+  EXPECT_EQ(rig.engine.schedule(1)[0].state, EntryState::active);
+  rig.engine.vehicle_passed(1, rig.c, 13.0);
+  for (double t = 13.0; t <= 40.0; t += 0.5) rig.run_until(t);
+  EXPECT_EQ(rig.engine.schedule(2)[0].state, EntryState::active);
+  EXPECT_TRUE(rig.monitor.violations().empty());
 }
 
 // Property test: many random missions with planner routes over a grid of signalized junctions,

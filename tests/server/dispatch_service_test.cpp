@@ -177,6 +177,35 @@ TEST(DispatchService, CongestionOnTheRouteChangesIt) {
   EXPECT_EQ(service.mission(m.id).route.edges, m.route.edges);
 }
 
+// An expiry ends only the update it came with: a later closure without expiry stays in force.
+TEST(DispatchService, OldExpiryDoesNotReopenALaterClosure) {
+  DispatchService service(grid(), {}, nullptr, 0.0);
+  const MissionView m = service.create_mission(request("amb-4"), 0.0);
+  const EdgeId e = m.route.edges[m.route.edges.size() / 2];
+  CongestionUpdate slow;
+  slow.edge = e;
+  slow.factor = 3.0;
+  slow.expires_in_s = 60.0;
+  service.report_congestion({slow}, 1.0);
+  CongestionUpdate closed;
+  closed.edge = e;
+  closed.speed_kmh = 0.0;  // closed until further notice
+  service.report_congestion({closed}, 2.0);
+  auto uses = [&](EdgeId x) {
+    const auto edges = service.mission(m.id).route.edges;
+    return std::count(edges.begin(), edges.end(), x);
+  };
+  EXPECT_EQ(uses(e), 0);
+  service.tick(100.0);  // the first update's expiry passes
+  EXPECT_EQ(uses(e), 0);
+  // And the reverse order: a later update with an earlier expiry ends at its own time.
+  CongestionUpdate brief = slow;
+  brief.expires_in_s = 10.0;
+  service.report_congestion({brief}, 101.0);
+  service.tick(120.0);
+  EXPECT_EQ(service.mission(m.id).route.edges, m.route.edges);
+}
+
 TEST(DispatchService, OsmWayUpdatesAndClosuresApplyToEveryEdgeOfTheWay) {
   DispatchService service(grid(), {}, nullptr, 0.0);
   CongestionUpdate u;
