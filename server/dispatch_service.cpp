@@ -97,14 +97,14 @@ std::vector<planner::EdgePoint> DispatchService::endpoints(const maps::SnapResul
   std::vector<planner::EdgePoint> both{{s.edge, s.offset_m}};
   if (s.twin.valid()) both.push_back({s.twin, s.twin_offset_m});
   if (both.size() == 2) {
-    // At a node, the two directions are one place: keep the one without a zero-length stub, so a
+    // At a node, the two directions are one place: keep the one without a zero-length end piece, so a
     // route never lists an edge it does not drive (a goal is the end of the edge arriving there,
     // a start the beginning of the edge leaving it).
     constexpr double kAtNodeM = 0.01;
     for (std::size_t i = 0; i < 2; ++i) {
       const double off = both[i].offset_m, len = graph_.length_m(both[i].edge);
-      const bool stub = role == Role::goal ? off <= kAtNodeM : off >= len - kAtNodeM;
-      if (stub) return {both[1 - i]};
+      const bool empty_piece = role == Role::goal ? off <= kAtNodeM : off >= len - kAtNodeM;
+      if (empty_piece) return {both[1 - i]};
     }
   }
   if (!heading || both.size() == 1) return both;
