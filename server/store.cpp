@@ -115,6 +115,9 @@ Store::Store(const std::filesystem::path& file, Durability durability) : file_(f
   }
   sqlite3_busy_timeout(db_, 5000);
   try {
+    // One server owns its database: exclusive locking drops the per-transaction fcntl locks and
+    // keeps a second server from opening the same file.
+    exec("PRAGMA locking_mode=EXCLUSIVE");
     exec("PRAGMA journal_mode=WAL");
     exec(durability == Durability::power_loss ? "PRAGMA synchronous=FULL" : "PRAGMA synchronous=NORMAL");
     exec("PRAGMA foreign_keys=ON");
