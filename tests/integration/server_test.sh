@@ -22,7 +22,8 @@ fail() { echo "FAIL: $*" >&2; failed=$((failed + 1)); }
 check() { if eval "$2"; then pass; else fail "$1"; fi; }
 
 cat > "$work/config.json" << 'JSON'
-{"tokens": [
+{"limits": {"read_timeout_s": 2},
+ "tokens": [
   {"token": "viewer-token-0123456789abcdef", "name": "wall", "roles": ["viewer"]},
   {"token": "amb1-vehicle-token-0123456789", "name": "amb1", "roles": ["vehicle"], "vehicle_id": "amb-1"}
 ]}
@@ -114,6 +115,23 @@ head -c 2000000 /dev/zero | tr '\0' 'x' > "$work/huge.txt"
 huge=$(curl -s -o /dev/null -w '%{http_code}' -X POST -H "Authorization: Bearer $TOKEN" --data-binary @"$work/huge.txt" "http://127.0.0.1:$port/v1/congestion")
 check "huge body: 413" "[[ $huge == 413 ]]"
 check "server still healthy" "[[ \$(api GET /v1/health) == 200 ]]"
+# A slow client (connects, sends half a request, then nothing) is cut off after the read timeout.
+slow=$(python3 - "$port" << 'PY'
+import socket, sys, time
+s = socket.create_connection(("127.0.0.1", int(sys.argv[1])))
+s.sendall(b"POST /v1/congestion HTTP/1.1\r\nHost: x\r\nContent-Length: 100\r\n\r\n{")
+s.settimeout(10)
+start = time.time()
+try:
+    data = s.recv(4096)
+except socket.timeout:
+    data = None
+elapsed = time.time() - start
+print("cut-off" if data == b"" and 1.0 <= elapsed <= 6.0 else f"data={data!r} after {elapsed:.1f}s")
+PY
+)
+check "slow client cut off after the 2 s read timeout ($slow)" "[[ '$slow' == cut-off ]]"
+check "server healthy after the slow client" "[[ \$(api GET /v1/health) == 200 ]]"
 
 # 6. kill -9 under load: every acknowledged position is stored, and the active mission resumes.
 status=$(api POST /v1/missions '{"vehicle_id":"amb-7","origin":{"lat":43.7384,"lon":7.4246},"destination":{"lat":43.7496,"lon":7.4365}}')

@@ -155,6 +155,27 @@ TEST(Router, SignalsMapHealthAndMetrics) {
       << metrics.body;
 }
 
+// Per-token token bucket: a burst is allowed, then 429 until time refills it; other tokens are
+// not affected.
+TEST(Router, RateLimitPerToken) {
+  DispatchService service(grid(), {}, nullptr, 0.0);
+  double now = 0.0;
+  RouterConfig config;
+  config.burst_per_token = 5;
+  config.rate_per_token_per_s = 2;
+  Router router(service, Rig::make_auth(), config, [&] { return now; });
+  for (int i = 0; i < 5; ++i) EXPECT_EQ(router.handle({"GET", "/v1/signals", kViewer, ""}).status, 200);
+  const auto limited = router.handle({"GET", "/v1/signals", kViewer, ""});
+  EXPECT_EQ(limited.status, 429);
+  EXPECT_EQ(body(limited)["error"]["code"], "rate_limited");
+  EXPECT_EQ(router.handle({"GET", "/v1/signals", kDispatcher, ""}).status, 200);  // its own bucket
+  now += 1.0;  // two more requests' worth
+  EXPECT_EQ(router.handle({"GET", "/v1/signals", kViewer, ""}).status, 200);
+  EXPECT_EQ(router.handle({"GET", "/v1/signals", kViewer, ""}).status, 200);
+  EXPECT_EQ(router.handle({"GET", "/v1/signals", kViewer, ""}).status, 429);
+  EXPECT_EQ(router.handle({"GET", "/v1/health", "", ""}).status, 200);  // open endpoints are not limited
+}
+
 // The OpenAPI document lists exactly the routes the router serves, and only those.
 TEST(Router, OpenApiMatchesTheImplementation) {
   Rig rig;
