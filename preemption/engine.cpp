@@ -304,6 +304,14 @@ void PreemptionEngine::cancel(MissionId mission, double now_s) {
   }
 }
 
+void PreemptionEngine::forget(MissionId mission, double now_s) {
+  cancel(mission, now_s);
+  missions_.erase(mission);
+  for (auto it = exhausted_.begin(); it != exhausted_.end();) {
+    it = it->first == mission ? exhausted_.erase(it) : std::next(it);
+  }
+}
+
 void PreemptionEngine::record_counts(NodeId node, maps::Compass approach, double time_s, double arrivals,
                                      double departures) {
   if (plans_.count(node) == 0) throw CountError("node " + std::to_string(node.v) + " has no signal");

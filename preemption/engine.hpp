@@ -87,6 +87,9 @@ class PreemptionEngine {
   // The vehicle cleared the stop line: release the signal behind it.
   void vehicle_passed(MissionId mission, NodeId node, double now_s);
   void cancel(MissionId mission, double now_s);
+  // Drops a mission whose entries are all finished (after cancel or completion), so a long-running
+  // server does not keep every schedule it ever made. Live entries are cancelled first.
+  void forget(MissionId mission, double now_s);
   // Detector counts for the queue estimate. Throws CountError for bad counts.
   void record_counts(NodeId node, maps::Compass approach, double time_s, double arrivals, double departures);
   // Occupancy (0..1) or measured/free speed ratio of an approach, for the congestion classifier

@@ -34,6 +34,7 @@ struct DispatchService::Mission {
   std::unique_ptr<planner::DStarLite> planner;
   planner::Route route;
   std::uint32_t revision = 0;
+  std::vector<preemption::ScheduleEntry> final_schedule;  // kept when the engine forgets the mission
 };
 
 namespace {
@@ -125,7 +126,7 @@ MissionView DispatchService::view(const Mission& m) const {
   v.last_position = m.last_position;
   v.route = m.route;
   v.route_revision = m.revision;
-  v.schedule = preemption_.schedule(m.row.id);
+  v.schedule = m.row.state == MissionState::active ? preemption_.schedule(m.row.id) : m.final_schedule;
   v.created_s = m.row.created_s;
   v.updated_s = m.row.updated_s;
   return v;
@@ -243,6 +244,8 @@ void DispatchService::finish(Mission& m, MissionState state, double now_s) {
   m.row.updated_s = now_s;
   active_by_vehicle_.erase(m.row.vehicle_id);
   preemption_.cancel(m.row.id, now_s);
+  m.final_schedule = preemption_.schedule(m.row.id);
+  preemption_.forget(m.row.id, now_s);
   m.planner.reset();  // a finished mission keeps its last route, not its search state
   emit(state == MissionState::completed ? "mission_completed" : "mission_cancelled", m.row.id, "", now_s);
   drain_preemption_events();

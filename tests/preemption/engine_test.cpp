@@ -134,6 +134,19 @@ TEST(PreemptionEngine, VehicleThatNeverArrivesExpiresAndTheSignalRecovers) {
   EXPECT_TRUE(rig.monitor.violations().empty());
 }
 
+TEST(PreemptionEngine, ForgetDropsAFinishedMission) {
+  Rig rig;
+  const std::vector<Crossing> route{rig.crossing(kW, kE, 20.0)};
+  rig.engine.update_route(4, 1, route, 0.0);
+  rig.run_until(19.0);
+  ASSERT_TRUE(rig.engine.holding(rig.c));
+  rig.engine.forget(4, 19.5);  // releases what it still held
+  EXPECT_FALSE(rig.engine.holding(rig.c));
+  EXPECT_TRUE(rig.engine.schedule(4).empty());
+  rig.run_until(19.5 + 5.0 + 2 * (3.0 + 2.0));
+  EXPECT_TRUE(rig.monitor.violations().empty());
+}
+
 TEST(PreemptionEngine, RerouteAwayCancelsAndReleases) {
   Rig rig;
   const std::vector<Crossing> route{rig.crossing(kW, kE, 20.0)};

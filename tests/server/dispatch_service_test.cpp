@@ -149,6 +149,10 @@ TEST(DispatchService, PositionsAlongTheRouteCompleteTheMission) {
   EXPECT_EQ(service.active_mission_count(), 0u);
   EXPECT_TRUE(std::any_of(events.begin(), events.end(), [](const auto& e) { return e.kind == "mission_completed"; }));
   EXPECT_TRUE(std::any_of(events.begin(), events.end(), [](const auto& e) { return e.kind == "preemption_released"; }));
+  // The finished mission still shows its final schedule.
+  const auto finished = service.mission(m.id).schedule;
+  EXPECT_FALSE(finished.empty());
+  for (const auto& e : finished) EXPECT_NE(e.state, preemption::EntryState::active);
 }
 
 TEST(DispatchService, CongestionOnTheRouteChangesIt) {
