@@ -13,6 +13,7 @@
 #include "planner/dstar_lite.hpp"
 #include "planner/one_to_one_search.hpp"
 #include "planner/route_geojson.hpp"
+#include "planner/snap_points.hpp"
 
 namespace corridor::app {
 namespace {
@@ -44,12 +45,6 @@ maps::LatLon parse_lat_lon(const std::string& text, const char* option) {
     throw UsageError(std::string(option) + " is not a valid coordinate: latitude must be in [-90, 90] and longitude in [-180, 180]");
   }
   return p;
-}
-
-std::vector<planner::EdgePoint> both_directions(const maps::SnapResult& s) {
-  std::vector<planner::EdgePoint> points{{s.edge, s.offset_m}};
-  if (s.twin.valid()) points.push_back({s.twin, s.twin_offset_m});
-  return points;
 }
 
 void run_route(const RouteOptions& o) {
@@ -84,15 +79,16 @@ void run_route(const RouteOptions& o) {
   planner::CostOverlay overlay(graph);
   overlay.set_signal_delay(graph, o.signal_delay_s);
   const planner::TravelCost cost(graph, overlay, {o.vmax_kmh / 3.6});
+  const auto starts = planner::points_from_snap(graph, s, planner::PointRole::start);
+  const auto goals = planner::points_from_snap(graph, t, planner::PointRole::goal);
   planner::Route route;
   if (algo == planner::Algorithm::dstar_lite) {
-    planner::DStarLite dstar(cost, both_directions(s), both_directions(t));
+    planner::DStarLite dstar(cost, starts, goals);
     dstar.replan();
     route = dstar.route();
   } else {
     planner::OneToOneSearch search;
-    route = search.run(planner::SearchSpace(cost, both_directions(s), both_directions(t)),
-                       algo == planner::Algorithm::astar);
+    route = search.run(planner::SearchSpace(cost, starts, goals), algo == planner::Algorithm::astar);
   }
   if (!route.found) throw std::runtime_error("no route: the destination cannot be reached from the start");
   auto feature = planner::route_to_geojson(graph, route, planner::to_string(algo));

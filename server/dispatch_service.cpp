@@ -7,6 +7,7 @@
 #include "maps/errors.hpp"
 #include "maps/intersection_geometry.hpp"
 #include "planner/route_geojson.hpp"
+#include "planner/snap_points.hpp"
 
 namespace corridor::server {
 
@@ -95,24 +96,12 @@ void DispatchService::emit(const std::string& kind, MissionId mission, const std
 
 std::vector<planner::EdgePoint> DispatchService::endpoints(const maps::SnapResult& s, Role role,
                                                            std::optional<double> heading) const {
-  std::vector<planner::EdgePoint> both{{s.edge, s.offset_m}};
-  if (s.twin.valid()) both.push_back({s.twin, s.twin_offset_m});
-  if (both.size() == 2) {
-    // At a node, the two directions are one place: keep the one without a zero-length end piece, so a
-    // route never lists an edge it does not drive (a goal is the end of the edge arriving there,
-    // a start the beginning of the edge leaving it).
-    constexpr double kAtNodeM = 0.01;
-    for (std::size_t i = 0; i < 2; ++i) {
-      const double off = both[i].offset_m, len = graph_.length_m(both[i].edge);
-      const bool empty_piece = role == Role::goal ? off <= kAtNodeM : off >= len - kAtNodeM;
-      if (empty_piece) return {both[1 - i]};
-    }
-  }
-  if (!heading || both.size() == 1) return both;
+  auto points = planner::points_from_snap(graph_, s, role == Role::goal ? planner::PointRole::goal : planner::PointRole::start);
+  if (!heading || points.size() == 1) return points;
   // A heading picks the direction of travel on a two-way street.
-  const double a = angle_between_deg(bearing_deg(graph_, both[0].edge, both[0].offset_m), *heading);
-  const double b = angle_between_deg(bearing_deg(graph_, both[1].edge, both[1].offset_m), *heading);
-  return {a <= b ? both[0] : both[1]};
+  const double a = angle_between_deg(bearing_deg(graph_, points[0].edge, points[0].offset_m), *heading);
+  const double b = angle_between_deg(bearing_deg(graph_, points[1].edge, points[1].offset_m), *heading);
+  return {a <= b ? points[0] : points[1]};
 }
 
 MissionView DispatchService::view(const Mission& m) const {

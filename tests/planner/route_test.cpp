@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "planner/route_geojson.hpp"
+#include "planner/snap_points.hpp"
 #include "tests/planner/test_graphs_line.hpp"
 
 namespace corridor::planner {
@@ -60,6 +61,31 @@ TEST(Route, GeoJsonFeatureIsLonLatWithProperties) {
   EXPECT_EQ(f["properties"]["algorithm"], "astar");
   EXPECT_EQ(f["properties"]["nodes"].size(), 1u);
   EXPECT_EQ(f["properties"]["signals"].size(), 1u);
+}
+
+// A coordinate exactly on node B: as a goal it is the end of A->B (no zero-length piece of B->A),
+// as a start the beginning of B->A; mid-edge, both directions stay.
+TEST(SnapPoints, NodeCoordinatesGiveNoZeroLengthPieces) {
+  const auto g = diamond();
+  const EdgeId ab = edge_from_to(g, 1, 2), ba = edge_from_to(g, 2, 1);
+  maps::SnapResult at_b;
+  at_b.edge = ab;
+  at_b.offset_m = 100.0;
+  at_b.twin = ba;
+  at_b.twin_offset_m = 0.0;
+  const auto goal = points_from_snap(g, at_b, PointRole::goal);
+  ASSERT_EQ(goal.size(), 1u);
+  EXPECT_EQ(goal[0].edge, ab);
+  EXPECT_DOUBLE_EQ(goal[0].offset_m, 100.0);
+  const auto start = points_from_snap(g, at_b, PointRole::start);
+  ASSERT_EQ(start.size(), 1u);
+  EXPECT_EQ(start[0].edge, ba);
+  EXPECT_DOUBLE_EQ(start[0].offset_m, 0.0);
+  maps::SnapResult mid = at_b;
+  mid.offset_m = 40.0;
+  mid.twin_offset_m = 60.0;
+  EXPECT_EQ(points_from_snap(g, mid, PointRole::goal).size(), 2u);
+  EXPECT_EQ(points_from_snap(g, mid, PointRole::start).size(), 2u);
 }
 
 }  // namespace
