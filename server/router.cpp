@@ -176,7 +176,8 @@ Router::Router(DispatchService& service, TokenAuth auth, RouterConfig config, Cl
 Router::~Router() { service_.unsubscribe(subscription_); }
 
 void Router::add(std::string method, std::string pattern, std::uint8_t roles, std::string summary, Handler handler) {
-  routes_.push_back({std::move(method), std::move(pattern), roles, std::move(summary), std::move(handler)});
+  auto segments = split_path(pattern);
+  routes_.push_back({std::move(method), std::move(pattern), std::move(segments), roles, std::move(summary), std::move(handler)});
 }
 
 HttpResponse Router::json_response(int status, const json& body) const {
@@ -222,7 +223,7 @@ HttpResponse Router::handle(const HttpRequest& request) noexcept {
     const Route* found = nullptr;
     bool path_known = false;
     for (const Route& r : routes_) {
-      const auto pattern = split_path(r.pattern);
+      const auto& pattern = r.segments;
       if (pattern.size() != parts.size()) continue;
       std::vector<std::string> params;
       bool ok = true;
@@ -291,7 +292,7 @@ json Router::openapi() const {
     if (r.method == "POST" && r.pattern == "/v1/missions") op["responses"]["201"] = {{"description", "Created"}};
     if (r.roles != 0) op["security"] = json::array({{{"bearer", json::array()}}});
     json params = json::array();
-    for (const auto& part : split_path(r.pattern)) {
+    for (const auto& part : r.segments) {
       if (part.front() == '{') {
         params.push_back({{"name", part.substr(1, part.size() - 2)}, {"in", "path"}, {"required", true}, {"schema", {{"type", "string"}}}});
       }

@@ -60,6 +60,7 @@ class Router {
   struct Route {
     std::string method;
     std::string pattern;  // "/v1/missions/{id}"
+    std::vector<std::string> segments;  // pattern split once, for matching
     std::uint8_t roles;   // any of these may call; 0 = no token needed
     std::string summary;
     Handler handler;
