@@ -7,6 +7,7 @@
 
 #include "app/bench_command.hpp"
 #include "app/cli_error.hpp"
+#include "app/experiment_command.hpp"
 #include "app/map_command.hpp"
 #include "app/preemption_command.hpp"
 #include "app/route_command.hpp"
@@ -29,11 +30,14 @@ int main(int argc, char** argv) {
   corridor::app::register_bench_command(app);
   corridor::app::register_preemption_command(app);
   corridor::app::register_serve_command(app);
+  corridor::app::register_experiment_command(app);
 
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // CLI11 prints the message; every usage error exits with 2, like UsageError below.
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : 2;
   } catch (const corridor::app::UsageError& e) {
     std::cerr << "error: " << e.what() << '\n';
     return 2;
