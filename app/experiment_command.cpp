@@ -23,6 +23,7 @@ struct AnalyticalCommandOptions {
   std::uint32_t pairs = 1000;
   unsigned threads = 2;
   double vmax_kmh = 120.0;
+  std::string map_signals = "junctions";
   MapOptions map;  // cache settings for OSM files
 };
 
@@ -59,6 +60,13 @@ void run_analytical(const AnalyticalCommandOptions& o) {
   options.threads = o.threads;
   options.vehicle.vmax_mps = o.vmax_kmh / 3.6;
   options.out_dir = o.out_dir;
+  if (o.map_signals == "junctions") {
+    options.map_signals = planner::MapSignals::junctions;
+  } else if (o.map_signals == "mapped") {
+    options.map_signals = planner::MapSignals::mapped;
+  } else {
+    throw UsageError("--map-signals must be junctions or mapped, got '" + o.map_signals + "'");
+  }
   try {
     std::filesystem::create_directories(options.out_dir);
   } catch (const std::filesystem::filesystem_error& e) {
@@ -99,6 +107,9 @@ void register_experiment_command(CLI::App& app) {
   analytical->add_option("--threads", o->threads, "trips simulated in parallel (results do not depend on it)")
       ->capture_default_str();
   analytical->add_option("--vmax-kmh", o->vmax_kmh, "emergency vehicle maximum speed")->capture_default_str();
+  analytical->add_option("--map-signals", o->map_signals,
+                         "on maps, signal delays at every junction (the paper's model) or only at mapped signals")
+      ->capture_default_str();
   analytical->add_option("--cache-dir", o->map.cache_dir, "where imported maps are cached");
   analytical->add_flag("--no-cache", o->map.no_cache, "import maps without reading or writing a cache");
   analytical->callback([o] { run_analytical(*o); });

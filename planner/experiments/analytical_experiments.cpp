@@ -40,6 +40,7 @@ struct GraphContext {
   const maps::RoadGraph& graph;
   std::string name;
   std::function<std::string(NodeId)> node_name;
+  std::vector<std::uint8_t> has_signal;  // where signal delays apply without preemption
   NodeId source;  // the default pair, for experiments without random pairs
   NodeId destination;
   double min_pair_distance_m = 0.0;
@@ -99,8 +100,10 @@ std::vector<Trip> make_trips(const GraphContext& ctx, const ExperimentSpec& spec
     if (spec.random_pairs) {
       std::tie(s, t) = draw_pair(ctx.graph, ctx.min_pair_distance_m, ctx.min_pair_edges, options.vehicle, rng);
     }
-    TripScenario scenario{s, t, draw_signal_delays(ctx.graph, spec.signal, rng), {}};
-    const Route plan = static_plan(ctx.graph, scenario, Signals::no_preemption, options.vehicle);
+    TripScenario scenario{s, t, draw_signal_delays(ctx.has_signal, spec.signal, rng), {}};
+    // Congestion is placed and timed along the fastest plan (no signal waits): every jam on it
+    // appears before any of the four vehicles can reach it, so none is spared by being quick.
+    const Route plan = static_plan(ctx.graph, scenario, Signals::preemption, options.vehicle);
     if (spec.fixed_sites && !fixed) fixed = pick_congestion_sites(ctx.graph, plan, spec.placement, rng);
     const CongestionSites sites = fixed ? *fixed : pick_congestion_sites(ctx.graph, plan, spec.placement, rng);
     scenario.events = draw_events(sites, spec.queue, rng);
@@ -283,8 +286,14 @@ std::string strategy_label(const Strategy& s) {
 
 std::vector<ExperimentReport> run_graph_experiments(const AnalyticalGraph& g, const AnalyticalOptions& options) {
   require_runs(options);
-  const GraphContext ctx{g.graph, g.name.empty() ? "graph" : g.name, [&g](NodeId v) { return g.name_of(v); },
-                         g.source, g.destination, 0.0, 2};
+  const GraphContext ctx{g.graph,
+                         g.name.empty() ? "graph" : g.name,
+                         [&g](NodeId v) { return g.name_of(v); },
+                         g.graph.data().node_signalized,
+                         g.source,
+                         g.destination,
+                         0.0,
+                         2};
   const std::string pair = g.name_of(g.source) + " to " + g.name_of(g.destination);
   std::vector<ExperimentSpec> specs;
   ExperimentSpec levels = named_spec(g.name == "simple" ? "fig5" : g.name == "complex" ? "fig6" : "levels",
@@ -329,6 +338,7 @@ std::vector<ExperimentReport> run_map_experiments(const maps::RoadGraph& graph, 
   const GraphContext ctx{graph,
                          name,
                          [&graph](NodeId v) { return std::to_string(graph.osm_node(v).v); },
+                         options.map_signals == MapSignals::junctions ? junction_mask(graph) : graph.data().node_signalized,
                          NodeId{0},
                          NodeId{0},
                          std::min(1500.0, 0.3 * diagonal),

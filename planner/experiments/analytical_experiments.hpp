@@ -12,12 +12,19 @@
 
 namespace corridor::planner {
 
+// Where a real map's signal delays sit when there is no preemption.
+enum class MapSignals {
+  junctions,  // every intersection of three or more roads, as in the paper's model
+  mapped,     // only the intersections mapped with traffic signals in OSM
+};
+
 struct AnalyticalOptions {
   std::uint64_t seed = 1;
   std::uint32_t runs = 10;         // runs of Figs. 7-9 on a hand-made graph (the paper shows ten)
   std::uint32_t level_runs = 100;  // runs per congestion level, Figs. 5 and 6
   std::uint32_t pairs = 1000;      // start/goal pairs per experiment on a real map
   VehicleProfile vehicle;          // 120 km/h, as in the paper
+  MapSignals map_signals = MapSignals::junctions;
   unsigned threads = 1;            // trips evaluated in parallel; results do not depend on it
   std::filesystem::path out_dir;
 };

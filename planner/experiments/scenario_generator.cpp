@@ -30,12 +30,30 @@ std::uint64_t derive_seed(std::uint64_t seed, std::string_view stream) {
   return mix.next();
 }
 
-std::vector<double> draw_signal_delays(const maps::RoadGraph& graph, DelayRange range, Rng& rng) {
-  std::vector<double> delays(graph.node_count(), 0.0);
-  for (NodeId v : graph.nodes()) {
-    if (graph.signalized(v)) delays[v.index()] = rng.uniform(range.lo_s, range.hi_s);
+std::vector<double> draw_signal_delays(std::span<const std::uint8_t> has_signal, DelayRange range, Rng& rng) {
+  std::vector<double> delays(has_signal.size(), 0.0);
+  for (std::size_t v = 0; v < has_signal.size(); ++v) {
+    if (has_signal[v] != 0) delays[v] = rng.uniform(range.lo_s, range.hi_s);
   }
   return delays;
+}
+
+std::vector<double> draw_signal_delays(const maps::RoadGraph& graph, DelayRange range, Rng& rng) {
+  return draw_signal_delays(graph.data().node_signalized, range, rng);
+}
+
+std::vector<std::uint8_t> junction_mask(const maps::RoadGraph& graph) {
+  std::vector<std::uint8_t> mask(graph.node_count(), 0);
+  std::vector<NodeId> neighbours;
+  for (NodeId v : graph.nodes()) {
+    neighbours.clear();
+    for (EdgeId e : graph.out_edges(v)) neighbours.push_back(graph.head(e));
+    for (EdgeId e : graph.in_edges(v)) neighbours.push_back(graph.tail(e));
+    std::sort(neighbours.begin(), neighbours.end());
+    const auto distinct = std::unique(neighbours.begin(), neighbours.end()) - neighbours.begin();
+    mask[v.index()] = distinct >= 3 ? 1 : 0;
+  }
+  return mask;
 }
 
 CongestionSites pick_congestion_sites(const maps::RoadGraph& graph, const Route& plan, CongestionPlacement placement,

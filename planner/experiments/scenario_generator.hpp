@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <string_view>
 #include <vector>
 
@@ -44,8 +45,14 @@ struct CongestionSites {
   std::vector<double> reach_s;  // when the planned vehicle reaches each edge's decision point
 };
 
-// Signal delays: drawn per signalized intersection; 0 elsewhere.
+// Signal delays: drawn per node where has_signal is set (or the graph's signalized
+// intersections); 0 elsewhere.
+std::vector<double> draw_signal_delays(std::span<const std::uint8_t> has_signal, DelayRange range, Rng& rng);
 std::vector<double> draw_signal_delays(const maps::RoadGraph& graph, DelayRange range, Rng& rng);
+
+// 1 for every node that joins at least three roads: the "every intersection" of the paper's model,
+// on maps where few signals are mapped.
+std::vector<std::uint8_t> junction_mask(const maps::RoadGraph& graph);
 
 // Picks the congested links for a trip from its static plan without preemption.
 CongestionSites pick_congestion_sites(const maps::RoadGraph& graph, const Route& plan, CongestionPlacement placement,
