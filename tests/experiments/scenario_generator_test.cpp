@@ -104,3 +104,40 @@ TEST(ScenarioGenerator, PairsAreFarEnoughApartAndImpossibleRequestsFail) {
 
 }  // namespace
 }  // namespace corridor::planner
+
+namespace corridor::planner {
+namespace {
+
+TEST(ScenarioGenerator, JunctionsAreNodesJoiningAtLeastThreeRoads) {
+  maps::RoadGraphData d;
+  // a - b - c, and b - e: only b is a junction; two-way roads count once per neighbour.
+  d.origin = {47.0, 9.5};
+  d.node_x_m = {0, 100, 200, 100};
+  d.node_y_m = {0, 0, 0, 100};
+  d.node_osm_id = {OsmNodeId{1}, OsmNodeId{2}, OsmNodeId{3}, OsmNodeId{4}};
+  d.node_signalized = {0, 0, 0, 0};
+  const std::vector<std::pair<std::uint32_t, std::uint32_t>> arcs{{0, 1}, {1, 0}, {1, 2}, {1, 3}, {2, 1}, {3, 1}};
+  d.first_out = {0, 1, 4, 5, 6};
+  d.geometry_first = {0};
+  for (auto [u, v] : arcs) {
+    d.edge_tail.push_back(NodeId{u});
+    d.edge_head.push_back(NodeId{v});
+    d.edge_length_m.push_back(100.0);
+    d.edge_speed_mps.push_back(10.0f);
+    d.edge_osm_way.push_back(OsmWayId{1});
+    d.edge_class.push_back(maps::RoadClass::residential);
+    d.edge_twin.push_back(kInvalidEdge);
+    d.geometry.push_back({d.node_x_m[u], d.node_y_m[u]});
+    d.geometry.push_back({d.node_x_m[v], d.node_y_m[v]});
+    d.geometry_first.push_back(static_cast<std::uint32_t>(d.geometry.size()));
+  }
+  maps::build_reverse_adjacency(d);
+  const maps::RoadGraph g(std::move(d));
+  EXPECT_EQ(junction_mask(g), (std::vector<std::uint8_t>{0, 1, 0, 0}));
+  Rng rng(1);
+  const auto delays = draw_signal_delays(junction_mask(g), {180.0, 180.0}, rng);
+  EXPECT_EQ(delays, (std::vector<double>{0.0, 180.0, 0.0, 0.0}));
+}
+
+}  // namespace
+}  // namespace corridor::planner
