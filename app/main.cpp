@@ -12,6 +12,7 @@
 #include "app/preemption_command.hpp"
 #include "app/route_command.hpp"
 #include "app/serve_command.hpp"
+#include "app/sim_command.hpp"
 #include "maps/errors.hpp"
 #include "server/store.hpp"
 
@@ -31,6 +32,7 @@ int main(int argc, char** argv) {
   corridor::app::register_preemption_command(app);
   corridor::app::register_serve_command(app);
   corridor::app::register_experiment_command(app);
+  corridor::app::register_sim_command(app);
 
   try {
     app.parse(argc, argv);

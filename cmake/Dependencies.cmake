@@ -9,6 +9,9 @@ find_package(nlohmann_json 3.10 REQUIRED)
 find_package(spdlog REQUIRED)
 find_package(fmt REQUIRED)
 find_package(SQLite3 REQUIRED)
+# SUMO 1.15 (packages sumo, sumo-tools): the closed loop talks TraCI through libtracicpp.
+list(APPEND CMAKE_MODULE_PATH "${PROJECT_SOURCE_DIR}/cmake")
+find_package(SUMO REQUIRED)
 
 # Debian ships GeographicLib without a CMake config; find the library and header directly.
 find_library(GEOGRAPHICLIB_LIBRARY NAMES GeographicLib REQUIRED)

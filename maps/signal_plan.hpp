@@ -52,6 +52,10 @@ struct SignalPlan {
   std::vector<ProgramStep> program;    // the normal cycle, in order
   double yellow_s = 3.0;
   double all_red_s = 2.0;
+  // Optional, per movement: the graph edge a vehicle takes when it makes that movement (SUMO
+  // plans, where a movement is one link). Where set it identifies movements exactly; otherwise
+  // they are matched by compass sides.
+  std::vector<EdgeId> movement_edge;
 
   [[nodiscard]] bool conflicts(std::size_t a, std::size_t b) const { return conflict[a * movements.size() + b] != 0; }
   [[nodiscard]] std::optional<std::size_t> movement_index(Compass from, Compass to) const;
@@ -67,6 +71,10 @@ struct NemaTiming {
   double min_green_s = 5.0;
   double yellow_s = 3.0;
   double all_red_s = 2.0;
+  // Optional, per movement: the graph edge a vehicle takes when it makes that movement (SUMO
+  // plans, where a movement is one link). Where set it identifies movements exactly; otherwise
+  // they are matched by compass sides.
+  std::vector<EdgeId> movement_edge;
 };
 
 // The NEMA dual-ring 8-phase plan of the seed paper (and Kim & Kwon): movements 4/7 from North,

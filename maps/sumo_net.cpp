@@ -88,7 +88,7 @@ void on_start(void* user, const char* name, const char** attrs) {
   } else if (std::strcmp(name, "tlLogic") == 0) {
     net.tl_logics.push_back({a.str("id"), a.str("programID"), a.str("type"), {}});
   } else if (std::strcmp(name, "phase") == 0 && !net.tl_logics.empty()) {
-    net.tl_logics.back().phases.push_back({a.number("duration"), a.str("state"), a.number("minDur", a.number("duration"))});
+    net.tl_logics.back().phases.push_back({a.number("duration"), a.str("state"), a.number("minDur", 0.0)});
   } else if (std::strcmp(name, "location") == 0) {
     const auto offset = parse_shape(a.str("netOffset"));
     if (!offset.empty()) net.net_offset = offset.front();

@@ -53,7 +53,7 @@ struct SumoConnection {
 struct SumoTlPhase {
   double duration_s = 0;
   std::string state;
-  double min_duration_s = 0;
+  double min_duration_s = 0;  // 0 when the program does not set minDur (static programs)
 };
 
 struct SumoTlLogic {

@@ -1,0 +1,141 @@
+#include "maps/sumo_graph.hpp"
+
+#include <algorithm>
+#include <map>
+#include <numeric>
+
+#include "maps/errors.hpp"
+
+namespace corridor::maps {
+namespace {
+
+bool drivable(const SumoEdge& e) { return (e.function.empty() || e.function == "normal") && !e.lanes.empty(); }
+
+struct Arc {
+  NodeId tail;
+  NodeId head;
+  const SumoEdge* onto;
+};
+
+}  // namespace
+
+std::span<const EdgeId> SumoGraph::arcs(const std::string& sumo_edge) const {
+  const auto it = arcs_onto.find(sumo_edge);
+  if (it == arcs_onto.end()) return {};
+  return it->second;
+}
+
+SumoGraph build_sumo_graph(const SumoNet& net) {
+  std::vector<const SumoEdge*> edges;
+  for (const SumoEdge& e : net.edges) {
+    if (drivable(e)) edges.push_back(&e);
+  }
+  if (edges.empty()) throw MapLoadError("the SUMO network has no normal edge to drive on");
+
+  RoadGraphData d;
+  d.origin = {0.0, 0.0};  // the net's own metric frame; SUMO runs need no geographic position
+  std::vector<std::string> node_edge;
+  std::unordered_map<std::string, NodeId> stop_line;
+  auto add_node = [&](const SumoEdge& e, Point2 p) {
+    const NodeId v{static_cast<std::uint32_t>(node_edge.size())};
+    node_edge.push_back(e.id);
+    d.node_x_m.push_back(p.x_m);
+    d.node_y_m.push_back(p.y_m);
+    d.node_osm_id.push_back(OsmNodeId{static_cast<std::int64_t>(v.v + 1)});
+    const SumoJunction* j = net.junction(e.to);
+    d.node_signalized.push_back(j != nullptr && j->type.find("traffic_light") != std::string::npos ? 1 : 0);
+    return v;
+  };
+  for (const SumoEdge* e : edges) {
+    const auto& shape = e->lanes.front().shape;
+    const Point2 end = shape.empty() ? Point2{} : shape.back();
+    stop_line.emplace(e->id, add_node(*e, end));
+  }
+
+  std::vector<Arc> arcs;
+  std::map<std::pair<std::string, std::string>, bool> seen;  // one arc per edge pair, whatever the lanes
+  std::unordered_map<std::string, bool> has_predecessor;
+  for (const SumoConnection& c : net.connections) {
+    const auto from = stop_line.find(c.from);
+    const auto to = stop_line.find(c.to);
+    if (from == stop_line.end() || to == stop_line.end()) continue;  // internal or non-drivable edges
+    if (!seen.emplace(std::make_pair(c.from, c.to), true).second) continue;
+    arcs.push_back({from->second, to->second, net.edge(c.to)});
+    has_predecessor[c.to] = true;
+  }
+  for (const SumoEdge* e : edges) {
+    if (has_predecessor.contains(e->id)) continue;
+    const auto& shape = e->lanes.front().shape;
+    const NodeId entry = add_node(*e, shape.empty() ? Point2{} : shape.front());
+    d.node_signalized.back() = 0;
+    arcs.push_back({entry, stop_line.at(e->id), e});
+  }
+  std::stable_sort(arcs.begin(), arcs.end(), [](const Arc& a, const Arc& b) { return a.tail < b.tail; });
+
+  std::vector<std::string> sumo_edge_of_arc;
+  std::unordered_map<std::string, std::vector<EdgeId>> arcs_onto;
+  d.first_out.assign(node_edge.size() + 1, 0);
+  d.geometry_first.push_back(0);
+  std::map<std::pair<NodeId, NodeId>, EdgeId> by_ends;
+  for (const Arc& a : arcs) {
+    const EdgeId id{static_cast<std::uint32_t>(sumo_edge_of_arc.size())};
+    ++d.first_out[a.tail.index() + 1];
+    d.edge_tail.push_back(a.tail);
+    d.edge_head.push_back(a.head);
+    double speed = 0.0;
+    for (const SumoLane& l : a.onto->lanes) speed = std::max(speed, l.speed_mps);
+    d.edge_length_m.push_back(std::max(0.1, a.onto->lanes.front().length_m));
+    d.edge_speed_mps.push_back(static_cast<float>(std::max(speed, 0.1)));
+    d.edge_osm_way.push_back(OsmWayId{static_cast<std::int64_t>(id.v + 1)});
+    d.edge_class.push_back(RoadClass::primary);
+    // From the previous stop line over the junction onto the edge, to its own stop line.
+    d.geometry.push_back({d.node_x_m[a.tail.index()], d.node_y_m[a.tail.index()]});
+    for (const Point2& p : a.onto->lanes.front().shape) d.geometry.push_back(p);
+    if (d.geometry.size() - d.geometry_first.back() < 2) d.geometry.push_back({d.node_x_m[a.head.index()], d.node_y_m[a.head.index()]});
+    d.geometry_first.push_back(static_cast<std::uint32_t>(d.geometry.size()));
+    by_ends.emplace(std::make_pair(a.tail, a.head), id);
+    sumo_edge_of_arc.push_back(a.onto->id);
+    arcs_onto[a.onto->id].push_back(id);
+  }
+  std::partial_sum(d.first_out.begin(), d.first_out.end(), d.first_out.begin());
+  d.edge_twin.assign(arcs.size(), kInvalidEdge);
+  for (std::size_t i = 0; i < arcs.size(); ++i) {
+    const auto it = by_ends.find({arcs[i].head, arcs[i].tail});
+    if (it != by_ends.end()) d.edge_twin[i] = it->second;
+  }
+  build_reverse_adjacency(d);
+  return SumoGraph{RoadGraph(std::move(d)), std::move(sumo_edge_of_arc), std::move(node_edge), std::move(arcs_onto),
+                   std::move(stop_line)};
+}
+
+std::unordered_map<NodeId, SignalPlan> plans_by_node(const SumoGraph& graph, const SumoNet& /*net*/,
+                                                     const std::vector<SumoSignalPlan>& plans,
+                                                     std::unordered_map<NodeId, std::size_t>* tls_of) {
+  std::unordered_map<NodeId, SignalPlan> out;
+  for (std::size_t i = 0; i < plans.size(); ++i) {
+    const SumoSignalPlan& sp = plans[i];
+    std::vector<EdgeId> movement_edge(sp.links.size(), kInvalidEdge);
+    std::vector<NodeId> approaches;
+    for (std::size_t k = 0; k < sp.links.size(); ++k) {
+      const SumoConnection* c = sp.links[k];
+      if (c == nullptr) continue;
+      const auto from = graph.stop_line.find(c->from);
+      if (from == graph.stop_line.end()) continue;
+      for (EdgeId arc : graph.graph.out_edges(from->second)) {
+        if (graph.sumo_edge_of_arc[arc.index()] == c->to) movement_edge[k] = arc;
+      }
+      if (std::find(approaches.begin(), approaches.end(), from->second) == approaches.end()) approaches.push_back(from->second);
+    }
+    for (NodeId node : approaches) {
+      if (out.contains(node)) continue;
+      SignalPlan plan = sp.plan;
+      plan.node = node;
+      plan.movement_edge = movement_edge;
+      out.emplace(node, std::move(plan));
+      if (tls_of != nullptr) (*tls_of)[node] = i;
+    }
+  }
+  return out;
+}
+
+}  // namespace corridor::maps

@@ -1,0 +1,39 @@
+// A SUMO network as an edge-based RoadGraph, so that SUMO's turn rules hold in every route: each
+// SUMO edge's stop line is a graph node, and each SUMO connection (from edge -> to edge) is a graph
+// edge that drives the whole `to` edge. A U-turn or a turn SUMO does not connect is simply not in
+// the graph. SUMO edges that nothing leads into get an extra entry node at their start.
+#pragma once
+
+#include <optional>
+#include <span>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "maps/road_graph.hpp"
+#include "maps/sumo_net.hpp"
+
+namespace corridor::maps {
+
+struct SumoGraph {
+  RoadGraph graph;
+  std::vector<std::string> sumo_edge_of_arc;                     // by EdgeId: the SUMO edge it drives
+  std::vector<std::string> sumo_edge_of_node;                    // by NodeId: whose stop line (or entry) it is
+  std::unordered_map<std::string, std::vector<EdgeId>> arcs_onto;  // SUMO edge -> the graph edges driving it
+  std::unordered_map<std::string, NodeId> stop_line;              // SUMO edge -> its stop-line node
+
+  // The graph edges that put a vehicle on `sumo_edge`; empty for an unknown or internal edge.
+  [[nodiscard]] std::span<const EdgeId> arcs(const std::string& sumo_edge) const;
+};
+
+// Throws MapLoadError when the net has no drivable edge or a connection names an unknown edge.
+SumoGraph build_sumo_graph(const SumoNet& net);
+
+// The traffic lights as signal plans keyed by graph node: every stop line a light controls gets
+// that light's plan, with each movement (SUMO link) tied to the graph edge of its connection.
+// `tls_of` receives each node's index into `plans`.
+std::unordered_map<NodeId, SignalPlan> plans_by_node(const SumoGraph& graph, const SumoNet& net,
+                                                     const std::vector<SumoSignalPlan>& plans,
+                                                     std::unordered_map<NodeId, std::size_t>* tls_of = nullptr);
+
+}  // namespace corridor::maps

@@ -1,0 +1,69 @@
+// One closed-loop SUMO run: background traffic, an emergency vehicle, and Corridor's planner and
+// preemption engine in the loop. Every step the vehicle's position feeds D* Lite; SUMO's measured
+// edge travel times feed congestion updates at a fixed period; lane halting counts feed the
+// congestion classifier; route changes go back with setRoute and signal commands through the
+// SUMO SignalController.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "sim/sumo_scenario.hpp"
+
+namespace corridor::sim {
+
+enum class EvRouting { static_route, dynamic_route };
+enum class EvSignals { none, bluelight, corridor };
+const char* to_string(EvRouting r);
+const char* to_string(EvSignals s);
+
+struct ClosedLoopConfig {
+  bool with_ev = true;  // false: the baseline run for other vehicles' delay
+  EvRouting routing = EvRouting::dynamic_route;
+  EvSignals signals = EvSignals::corridor;
+  std::string ev_from;  // SUMO edge ids
+  std::string ev_to;
+  double ev_depart_s = 200.0;
+  double ev_vmax_kmh = 120.0;
+  double congestion_period_s = 10.0;  // how often measured travel times reach the planner
+  std::uint32_t incidents = 2;        // speed drops on the EV's route after it has left
+  double incident_speed_mps = 2.0;
+  double end_s = 1800.0;
+  std::uint64_t seed = 1;
+  std::filesystem::path background_routes;
+  std::filesystem::path out_dir;  // logs and tripinfo of this run
+  std::string run_name = "run";
+};
+
+struct ClosedLoopResult {
+  bool ev_arrived = false;
+  double ev_travel_time_s = 0.0;
+  int ev_stops = 0;
+  double ev_wait_s = 0.0;
+  double ev_time_loss_s = 0.0;
+  std::size_t preempted_signals = 0;  // distinct lights held for the EV
+  std::size_t preemptions_started = 0;
+  std::size_t preemptions_released = 0;
+  std::size_t lights_taken_over = 0;
+  std::size_t lights_back_on_program = 0;
+  std::vector<std::string> safety_violations;
+  int collisions = 0;
+  int teleports = 0;
+  std::uint32_t replans = 0;        // with new congestion
+  std::uint32_t route_changes = 0;  // sent to SUMO with setRoute
+  std::uint32_t congestion_updates = 0;
+  double others_mean_time_loss_s = 0.0;
+  std::size_t others = 0;
+  double end_time_s = 0.0;
+};
+
+// Throws SimError when SUMO fails or the EV's edges are unknown or unconnected.
+ClosedLoopResult run_closed_loop(const SumoScenario& scenario, const ClosedLoopConfig& config);
+
+// A start and goal for the EV: far apart, connected both ways, on edges SUMO lets it drive.
+std::pair<std::string, std::string> pick_ev_trip(const SumoScenario& scenario, std::uint64_t seed);
+
+}  // namespace corridor::sim

@@ -1,0 +1,103 @@
+#include "sim/scenario_builder.hpp"
+
+#include <fmt/format.h>
+
+#include <cstdlib>
+
+#include "sim/errors.hpp"
+#include "sim/process.hpp"
+
+namespace corridor::sim {
+namespace {
+
+std::filesystem::path sumo_home() {
+  const char* home = std::getenv("SUMO_HOME");
+  return home != nullptr && *home != '\0' ? std::filesystem::path(home) : std::filesystem::path("/usr/share/sumo");
+}
+
+void prepare(const std::filesystem::path& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw SimError("cannot create the scenario directory '" + dir.string() + "': " + ec.message());
+}
+
+bool up_to_date(const std::filesystem::path& out, const std::filesystem::path& input) {
+  std::error_code ec;
+  return std::filesystem::exists(out) && std::filesystem::file_size(out, ec) > 0 &&
+         (input.empty() || std::filesystem::last_write_time(out) >= std::filesystem::last_write_time(input));
+}
+
+}  // namespace
+
+ScenarioNet build_grid_net(const std::filesystem::path& dir, const GridSpec& spec) {
+  if (spec.blocks < 2 || spec.blocks > 50 || !(spec.block_m >= 20.0) || spec.lanes < 1 || spec.lanes > 4 ||
+      !(spec.speed_kmh > 0.0)) {
+    throw SimError("grid needs 2-50 junctions per side, blocks of at least 20 m, 1-4 lanes and a positive speed");
+  }
+  prepare(dir);
+  const std::string name = fmt::format("grid{}x{}", spec.blocks, spec.blocks);
+  ScenarioNet net{name, dir, dir / (name + ".net.xml")};
+  if (up_to_date(net.net, {})) return net;
+  run_tool({"netgenerate", "--grid", "--grid.number", std::to_string(spec.blocks), "--grid.length",
+            fmt::format("{}", spec.block_m), "--default.lanenumber", std::to_string(spec.lanes), "--default.speed",
+            fmt::format("{:.4f}", spec.speed_kmh / 3.6), "--default-junction-type", "traffic_light",
+            "--tls.default-type", "static", "--no-turnarounds", "true", "-o", net.net.string()},
+           dir / "netgenerate.log");
+  return net;
+}
+
+ScenarioNet build_osm_net(const std::filesystem::path& dir, const std::filesystem::path& osm_file) {
+  if (!std::filesystem::exists(osm_file)) throw SimError("OSM file '" + osm_file.string() + "' does not exist");
+  prepare(dir);
+  std::string name = osm_file.filename().string();
+  name = name.substr(0, name.find('.'));
+  ScenarioNet net{name, dir, dir / (name + ".net.xml")};
+  if (up_to_date(net.net, osm_file)) return net;
+  std::filesystem::path input = osm_file;
+  if (osm_file.extension() == ".pbf") {
+    input = dir / (name + ".osm");
+    run_tool({"osmium", "cat", "--overwrite", "-o", input.string(), osm_file.string()}, dir / "osmium.log");
+  }
+  run_tool({"netconvert", "--osm-files", input.string(), "--geometry.remove", "--ramps.guess", "--junctions.join",
+            "--tls.guess-signals", "--tls.discard-simple", "--tls.join", "--keep-edges.by-vclass", "passenger",
+            "--remove-edges.isolated", "--no-turnarounds", "true", "-o", net.net.string()},
+           dir / "netconvert.log");
+  return net;
+}
+
+ScenarioNet build_scenario_net(const std::string& scenario, const std::filesystem::path& dir) {
+  if (scenario == "grid") return build_grid_net(dir, GridSpec{});
+  const std::filesystem::path file(scenario);
+  if (!std::filesystem::exists(file)) {
+    throw SimError("--scenario must be grid, a .net.xml, or an OSM file (.osm, .osm.gz, .osm.pbf); '" + scenario +
+                   "' does not exist");
+  }
+  const std::string name = file.filename().string();
+  if (name.size() > 8 && name.ends_with(".net.xml")) {
+    prepare(dir);
+    return ScenarioNet{name.substr(0, name.size() - 8), dir, std::filesystem::absolute(file)};
+  }
+  if (name.ends_with(".osm") || name.ends_with(".osm.gz") || name.ends_with(".pbf")) return build_osm_net(dir, file);
+  throw SimError("'" + scenario + "' is neither a SUMO .net.xml nor an OSM file (.osm, .osm.gz, .osm.pbf)");
+}
+
+std::filesystem::path build_background_demand(const ScenarioNet& net, const DemandSpec& spec) {
+  if (!(spec.vehicles_per_hour > 0.0) || !(spec.end_s > 0.0)) {
+    throw SimError("background demand needs a positive volume and duration");
+  }
+  const std::string stem = fmt::format("{}_v{:g}_s{}_e{:g}", net.name, spec.vehicles_per_hour, spec.seed, spec.end_s);
+  const auto routes = net.dir / (stem + ".rou.xml");
+  if (up_to_date(routes, net.net)) return routes;
+  const auto script = sumo_home() / "tools" / "randomTrips.py";
+  if (!std::filesystem::exists(script)) {
+    throw SimError("randomTrips.py not found at " + script.string() + " (install sumo-tools, or set SUMO_HOME)");
+  }
+  run_tool({"/usr/bin/python3", script.string(), "-n", net.net.string(), "-o", (net.dir / (stem + ".trips.xml")).string(),
+            "-r", routes.string(), "--seed", std::to_string(spec.seed), "--begin", "0", "--end",
+            fmt::format("{:g}", spec.end_s), "--period", fmt::format("{:.6f}", 3600.0 / spec.vehicles_per_hour),
+            "--fringe-factor", "5", "--min-distance", "300", "--prefix", "bg", "--validate"},
+           net.dir / (stem + ".log"));
+  return routes;
+}
+
+}  // namespace corridor::sim

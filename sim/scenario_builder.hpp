@@ -1,0 +1,44 @@
+// Builds SUMO scenarios: a network from OSM (netconvert) or a Manhattan grid (netgenerate), and
+// seeded background demand (randomTrips.py + duarouter). Every file lands in one directory.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+namespace corridor::sim {
+
+struct GridSpec {
+  int blocks = 5;           // junctions per side
+  double block_m = 200.0;   // street length between junctions
+  int lanes = 2;            // per direction
+  double speed_kmh = 50.0;
+};
+
+struct ScenarioNet {
+  std::string name;  // "grid", or the OSM file's stem
+  std::filesystem::path dir;
+  std::filesystem::path net;
+};
+
+// A grid like the seed paper's: two lanes per direction, a traffic light at every junction.
+ScenarioNet build_grid_net(const std::filesystem::path& dir, const GridSpec& spec);
+
+// netconvert with the options of the issue (signals guessed and joined, passenger roads only).
+// A .pbf is first converted to .osm with osmium-tool, since netconvert does not read PBF.
+ScenarioNet build_osm_net(const std::filesystem::path& dir, const std::filesystem::path& osm_file);
+
+// "grid" (the default grid), a SUMO .net.xml used as it is, or an OSM file (.osm, .osm.gz, .pbf).
+ScenarioNet build_scenario_net(const std::string& scenario, const std::filesystem::path& dir);
+
+struct DemandSpec {
+  double vehicles_per_hour = 400.0;
+  double end_s = 900.0;  // insert background traffic until then
+  std::uint64_t seed = 1;
+};
+
+// Background traffic routes (.rou.xml) from randomTrips.py, run with /usr/bin/python3 because
+// SUMO's tools need Debian's Python modules. Reuses an existing file for the same spec.
+std::filesystem::path build_background_demand(const ScenarioNet& net, const DemandSpec& spec);
+
+}  // namespace corridor::sim
