@@ -9,6 +9,7 @@
 
 #include "app/cli_error.hpp"
 #include "app/map_options.hpp"
+#include "app/sim_command.hpp"
 #include "planner/experiments/analytical_experiments.hpp"
 
 namespace corridor::app {
@@ -113,6 +114,7 @@ void register_experiment_command(CLI::App& app) {
   analytical->add_option("--cache-dir", o->map.cache_dir, "where imported maps are cached");
   analytical->add_flag("--no-cache", o->map.no_cache, "import maps without reading or writing a cache");
   analytical->callback([o] { run_analytical(*o); });
+  register_sumo_experiment(*cmd);
 }
 
 }  // namespace corridor::app

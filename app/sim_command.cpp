@@ -2,11 +2,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include <fstream>
 #include <iostream>
 #include <memory>
 
 #include "app/cli_error.hpp"
 #include "sim/closed_loop.hpp"
+#include "sim/sumo_experiment.hpp"
 #include "sim/scenario_builder.hpp"
 #include "sim/sumo_scenario.hpp"
 
@@ -118,6 +120,49 @@ void register_sim_command(CLI::App& app) {
   cmd->callback([o] { run_sim(*o); });
 }
 
-void register_sumo_experiment(CLI::App& /*experiment*/) {}
+void register_sumo_experiment(CLI::App& experiment) {
+  auto o = std::make_shared<sim::SumoExperimentOptions>();
+  auto volumes = std::make_shared<std::string>("200,400,600,800");
+  auto* cmd = experiment.add_subcommand(
+      "sumo", "Closed-loop SUMO matrix: static/dynamic routing x none/bluelight/corridor signals over volumes and seeds");
+  cmd->add_option("--scenario", o->scenario, "grid, a SUMO .net.xml, or an OSM file (.osm, .osm.gz, .osm.pbf)")
+      ->capture_default_str();
+  cmd->add_option("--volumes", *volumes, "background volumes, vehicles/hour, comma-separated")->capture_default_str();
+  cmd->add_option("--seeds", o->seeds, "seeds per volume")->capture_default_str();
+  cmd->add_option("--first-seed", o->first_seed, "seeds are first-seed, first-seed+1, ...")->capture_default_str();
+  cmd->add_option("--out", o->out_dir, "output directory")->required();
+  cmd->add_option("--demand-end-s", o->demand_end_s, "background traffic is inserted until then")->capture_default_str();
+  cmd->add_option("--ev-depart-s", o->ev_depart_s, "when the EV departs")->capture_default_str();
+  cmd->add_option("--end-s", o->end_s, "every run ends at the latest then")->capture_default_str();
+  cmd->add_option("--congestion-period-s", o->congestion_period_s, "how often measured travel times reach the planner")
+      ->capture_default_str();
+  cmd->add_option("--incidents", o->incidents, "speed drops on the EV's route after it left")->capture_default_str();
+  cmd->add_option("--parallel", o->parallel, "SUMO runs at a time")->capture_default_str();
+  cmd->callback([o, volumes] {
+    o->volumes.clear();
+    std::string item;
+    for (std::size_t i = 0; i <= volumes->size(); ++i) {
+      if (i == volumes->size() || (*volumes)[i] == ',') {
+        try {
+          std::size_t used = 0;
+          const double v = std::stod(item, &used);
+          if (used != item.size()) throw std::invalid_argument(item);
+          o->volumes.push_back(v);
+        } catch (const std::exception&) {
+          throw UsageError("--volumes expects numbers separated by commas, such as 200,400,600; got '" + *volumes + "'");
+        }
+        item.clear();
+      } else {
+        item += (*volumes)[i];
+      }
+    }
+    if (o->seeds == 0 || o->seeds > 1000) throw UsageError("--seeds must be in [1, 1000]");
+    if (o->parallel == 0 || o->parallel > 64) throw UsageError("--parallel must be in [1, 64]");
+    if (!(o->end_s > o->ev_depart_s)) throw UsageError("--end-s must come after --ev-depart-s");
+    sim::run_sumo_experiment(*o);
+    std::ifstream md(o->out_dir / "sumo_summary.md");
+    std::cout << md.rdbuf() << "\nOutput in " << o->out_dir.string() << "\n";
+  });
+}
 
 }  // namespace corridor::app

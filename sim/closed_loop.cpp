@@ -103,7 +103,11 @@ std::pair<std::string, std::string> pick_ev_trip(const SumoScenario& scenario, s
     if (a == b || d < 0.5 * diagonal * (1.0 - attempt / 40000.0)) continue;
     const planner::SearchSpace space(cost, {{a, 0.0}}, {{b, g.length_m(b)}});
     const planner::Route r = search.run(space, true);
-    if (r.found && r.edges.size() >= 4) {
+    // A trip that crosses at least one traffic light, where the net has any: preemption is the point.
+    const bool crosses_light = scenario.plans.empty() || std::any_of(r.nodes.begin(), r.nodes.end(), [&](NodeId v) {
+                                 return scenario.plans.contains(v);
+                               });
+    if (r.found && r.edges.size() >= 4 && (crosses_light || attempt > 15000)) {
       return {scenario.graph.sumo_edge_of_arc[a.index()], scenario.graph.sumo_edge_of_arc[b.index()]};
     }
   }
@@ -182,7 +186,8 @@ ClosedLoopResult run_closed_loop(const SumoScenario& scenario, const ClosedLoopC
   double last_congestion_s = -1e9;
   std::vector<Incident> incidents;
   std::set<NodeId> preempted;
-  planner::Rng rng(planner::derive_seed(config.seed, "incidents/" + config.run_name));
+  // The same incidents in every run of a seed, whatever its routing and signals.
+  planner::Rng rng(planner::derive_seed(config.seed, "incidents"));
 
   double t = 0.0;
   for (int step = 0; t < config.end_s; ++step) {

@@ -63,7 +63,8 @@ struct ClosedLoopResult {
 // Throws SimError when SUMO fails or the EV's edges are unknown or unconnected.
 ClosedLoopResult run_closed_loop(const SumoScenario& scenario, const ClosedLoopConfig& config);
 
-// A start and goal for the EV: far apart, connected both ways, on edges SUMO lets it drive.
+// A start and goal for the EV: far apart, connected, on edges SUMO lets it drive, and with at
+// least one traffic light between them where the network has any.
 std::pair<std::string, std::string> pick_ev_trip(const SumoScenario& scenario, std::uint64_t seed);
 
 }  // namespace corridor::sim

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <set>
 
 #include "maps/errors.hpp"
 #include "preemption/phase_selection.hpp"
@@ -122,6 +123,62 @@ TEST(SumoNet, BadFilesAreClearErrors) {
   std::ofstream(path) << "<osm version=\"0.6\"></osm>\n";
   EXPECT_THROW((void)read_sumo_net(path), MapLoadError);
   std::filesystem::remove(path);
+}
+
+}  // namespace
+}  // namespace corridor::maps
+
+#include "maps/sumo_graph.hpp"
+
+namespace corridor::maps {
+namespace {
+
+TEST(SumoGraph, EveryGraphEdgeIsASumoConnectionSoTurnRulesHold) {
+  const SumoNet& net = monaco();
+  const SumoGraph g = build_sumo_graph(net);
+  std::set<std::pair<std::string, std::string>> connected;
+  for (const auto& c : net.connections) connected.emplace(c.from, c.to);
+  std::size_t entry_arcs = 0;
+  for (EdgeId e : g.graph.edges()) {
+    const std::string& from = g.sumo_edge_of_node[g.graph.tail(e).index()];
+    const std::string& onto = g.sumo_edge_of_arc[e.index()];
+    EXPECT_EQ(g.sumo_edge_of_node[g.graph.head(e).index()], onto);
+    if (from == onto) {
+      ++entry_arcs;  // the entry node of an edge nothing leads into
+      continue;
+    }
+    EXPECT_TRUE(connected.contains({from, onto})) << from << " -> " << onto << " is not a SUMO connection";
+  }
+  EXPECT_GT(g.graph.edge_count(), 500u);
+  EXPECT_LT(entry_arcs, g.graph.edge_count() / 5);
+  for (const auto& [sumo_edge, arcs] : g.arcs_onto) {
+    ASSERT_FALSE(arcs.empty());
+    for (EdgeId arc : arcs) EXPECT_EQ(g.graph.head(arc), g.stop_line.at(sumo_edge));
+  }
+}
+
+TEST(SumoGraph, SignalPlansSitOnTheStopLinesTheirLightControlsWithExactMovements) {
+  const SumoNet& net = monaco();
+  const SumoGraph g = build_sumo_graph(net);
+  const auto sumo_plans = sumo_signal_plans(net);
+  std::unordered_map<NodeId, std::size_t> tls_of;
+  const auto plans = plans_by_node(g, net, sumo_plans, &tls_of);
+  ASSERT_FALSE(plans.empty());
+  for (const auto& [node, plan] : plans) {
+    EXPECT_EQ(plan.node, node);
+    EXPECT_TRUE(g.graph.signalized(node));
+    const SumoSignalPlan& sp = sumo_plans.at(tls_of.at(node));
+    ASSERT_EQ(plan.movement_edge.size(), sp.links.size());
+    bool from_here = false;
+    for (std::size_t k = 0; k < sp.links.size(); ++k) {
+      if (sp.links[k] == nullptr || !plan.movement_edge[k].valid()) continue;
+      const EdgeId arc = plan.movement_edge[k];
+      EXPECT_EQ(g.sumo_edge_of_node[g.graph.tail(arc).index()], sp.links[k]->from);
+      EXPECT_EQ(g.sumo_edge_of_arc[arc.index()], sp.links[k]->to);
+      from_here = from_here || g.graph.tail(arc) == node;
+    }
+    EXPECT_TRUE(from_here) << "the light of node " << node.v << " controls no link from its stop line";
+  }
 }
 
 }  // namespace
