@@ -184,10 +184,21 @@ ClosedLoopResult run_closed_loop(const SumoScenario& scenario, const ClosedLoopC
   std::string ev_edge = config.ev_from;  // the SUMO edge the EV is on
   double ev_pos = 0.0;
   double last_congestion_s = -1e9;
+  // Unforeseen incidents on the EV's free-flow route, after it has left: the same in every run of a
+  // seed, the baseline without the EV included, so that they do not count as the EV's doing.
   std::vector<Incident> incidents;
+  if (!starts.empty() && !goals.empty() && config.incidents > 0) {
+    planner::Rng rng(planner::derive_seed(config.seed, "incidents"));
+    const planner::CostOverlay free_flow(g);
+    const planner::TravelCost free_cost(g, free_flow, {vmax_mps});
+    planner::OneToOneSearch search;
+    const planner::Route r = search.run(planner::SearchSpace(free_cost, starts, goals), true);
+    for (std::uint32_t k = 0; k < config.incidents && r.found && r.edges.size() > 3; ++k) {
+      const EdgeId e = r.edges[1 + rng.below(static_cast<std::uint32_t>(r.edges.size() - 2))];
+      incidents.push_back({config.ev_depart_s + rng.uniform(10.0, 60.0), sg.sumo_edge_of_arc[e.index()]});
+    }
+  }
   std::set<NodeId> preempted;
-  // The same incidents in every run of a seed, whatever its routing and signals.
-  planner::Rng rng(planner::derive_seed(config.seed, "incidents"));
 
   double t = 0.0;
   for (int step = 0; t < config.end_s; ++step) {
@@ -242,11 +253,6 @@ ClosedLoopResult run_closed_loop(const SumoScenario& scenario, const ClosedLoopC
       libtraci::Vehicle::subscribe(kEv, {libsumo::VAR_ROAD_ID, libsumo::VAR_LANEPOSITION, libsumo::VAR_SPEED});
       ev_added = true;
       ev_depart = t;
-      // Unforeseen incidents on the route ahead, once the EV has left.
-      for (std::uint32_t k = 0; k < config.incidents && route.size() > 3; ++k) {
-        const EdgeId e = route[1 + rng.below(static_cast<std::uint32_t>(route.size() - 2))];
-        incidents.push_back({t + rng.uniform(10.0, 60.0), sg.sumo_edge_of_arc[e.index()]});
-      }
       changed.clear();  // the new planner already knows every update so far
     }
     for (Incident& inc : incidents) {

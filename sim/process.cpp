@@ -133,19 +133,32 @@ int free_tcp_port() {
 
 namespace {
 
-bool listening_on(int port) {
+// The socket inode listening on `port`, or 0.
+unsigned long listening_inode(int port) {
   for (const char* table : {"/proc/net/tcp", "/proc/net/tcp6"}) {
     std::ifstream in(table);
     std::string line;
     std::getline(in, line);  // header
     while (std::getline(in, line)) {
       std::istringstream fields(line);
-      std::string slot, local, remote, state;
-      fields >> slot >> local >> remote >> state;
+      std::string slot, local, remote, state, queues, timer, retransmits, uid, timeout;
+      unsigned long inode = 0;
+      fields >> slot >> local >> remote >> state >> queues >> timer >> retransmits >> uid >> timeout >> inode;
       const auto colon = local.rfind(':');
       if (colon == std::string::npos || state != "0A") continue;  // 0A = LISTEN
-      if (std::stoi(local.substr(colon + 1), nullptr, 16) == port) return true;
+      if (std::stoi(local.substr(colon + 1), nullptr, 16) == port) return inode;
     }
+  }
+  return 0;
+}
+
+// True when `pid` holds the socket: the listener is our child, not another process on that port.
+bool owns_socket(pid_t pid, unsigned long inode) {
+  const std::string wanted = "socket:[" + std::to_string(inode) + "]";
+  std::error_code ec;
+  for (const auto& fd : std::filesystem::directory_iterator("/proc/" + std::to_string(pid) + "/fd", ec)) {
+    std::error_code link_ec;
+    if (std::filesystem::read_symlink(fd.path(), link_ec).string() == wanted) return true;
   }
   return false;
 }
@@ -155,7 +168,7 @@ bool listening_on(int port) {
 bool wait_until_listening(int port, ChildProcess& child, double timeout_s) {
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
   while (std::chrono::steady_clock::now() < deadline) {
-    if (listening_on(port)) return true;
+    if (const unsigned long inode = listening_inode(port); inode != 0 && owns_socket(child.pid(), inode)) return true;
     if (!child.running()) return false;
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }

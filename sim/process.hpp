@@ -36,8 +36,8 @@ void run_tool(const std::vector<std::string>& argv, const std::filesystem::path&
 // A TCP port that was free a moment ago on the loopback interface.
 int free_tcp_port();
 
-// True once something listens on `port` (read from /proc/net/tcp, without connecting: SUMO takes
-// the first connection as its client). False if `child` ends first or `timeout_s` passes.
+// True once `child` listens on `port` (read from /proc, without connecting: SUMO takes the first
+// connection as its client). False if it ends first, or `timeout_s` passes.
 bool wait_until_listening(int port, ChildProcess& child, double timeout_s);
 
 // The last `lines` lines of a text file, for error messages.
