@@ -8,6 +8,7 @@
 
 #include "app/cli_error.hpp"
 #include "sim/closed_loop.hpp"
+#include "sim/result_json.hpp"
 #include "sim/sumo_experiment.hpp"
 #include "sim/scenario_builder.hpp"
 #include "sim/sumo_scenario.hpp"
@@ -44,28 +45,6 @@ sim::EvSignals parse_signals(const std::string& s) {
   throw UsageError("--signals must be none, bluelight or corridor, got '" + s + "'");
 }
 
-nlohmann::json to_json(const sim::ClosedLoopResult& r) {
-  return {{"ev_arrived", r.ev_arrived},
-          {"ev_travel_time_s", r.ev_travel_time_s},
-          {"ev_stops", r.ev_stops},
-          {"ev_wait_s", r.ev_wait_s},
-          {"ev_time_loss_s", r.ev_time_loss_s},
-          {"preempted_signals", r.preempted_signals},
-          {"preemptions_started", r.preemptions_started},
-          {"preemptions_released", r.preemptions_released},
-          {"lights_taken_over", r.lights_taken_over},
-          {"lights_back_on_program", r.lights_back_on_program},
-          {"safety_violations", r.safety_violations},
-          {"collisions", r.collisions},
-          {"teleports", r.teleports},
-          {"replans", r.replans},
-          {"route_changes", r.route_changes},
-          {"congestion_updates", r.congestion_updates},
-          {"others", r.others},
-          {"others_mean_time_loss_s", r.others_mean_time_loss_s},
-          {"end_time_s", r.end_time_s}};
-}
-
 void run_sim(const SimOptions& o) {
   if (!(o.volume > 0.0 && o.volume <= 20000.0)) throw UsageError("--volume must be in (0, 20000] vehicles/hour");
   if (!(o.congestion_period_s >= 1.0)) throw UsageError("--congestion-period-s must be at least 1");
@@ -87,7 +66,7 @@ void run_sim(const SimOptions& o) {
   c.out_dir = net.dir / "runs";
   c.run_name = std::string(sim::to_string(c.routing)) + "_" + sim::to_string(c.signals);
   const auto r = sim::run_closed_loop(*scenario, c);
-  nlohmann::json out = to_json(r);
+  nlohmann::json out = r;
   out["scenario"] = net.name;
   out["ev_from"] = c.ev_from;
   out["ev_to"] = c.ev_to;

@@ -13,6 +13,7 @@
 
 #include "planner/experiments/svg_chart.hpp"
 #include "sim/errors.hpp"
+#include "sim/result_json.hpp"
 #include "sim/scenario_builder.hpp"
 #include "sim/sumo_scenario.hpp"
 
@@ -21,40 +22,6 @@ namespace {
 
 constexpr EvRouting kRoutings[] = {EvRouting::static_route, EvRouting::dynamic_route};
 constexpr EvSignals kSignals[] = {EvSignals::none, EvSignals::bluelight, EvSignals::corridor};
-
-nlohmann::json to_json(const ClosedLoopResult& r) {
-  return {{"ev_arrived", r.ev_arrived}, {"ev_travel_time_s", r.ev_travel_time_s}, {"ev_stops", r.ev_stops},
-          {"ev_wait_s", r.ev_wait_s}, {"ev_time_loss_s", r.ev_time_loss_s}, {"preempted_signals", r.preempted_signals},
-          {"preemptions_started", r.preemptions_started}, {"preemptions_released", r.preemptions_released},
-          {"lights_taken_over", r.lights_taken_over}, {"lights_back_on_program", r.lights_back_on_program},
-          {"safety_violations", r.safety_violations}, {"collisions", r.collisions}, {"teleports", r.teleports},
-          {"replans", r.replans}, {"route_changes", r.route_changes}, {"congestion_updates", r.congestion_updates},
-          {"others_mean_time_loss_s", r.others_mean_time_loss_s}, {"others", r.others}, {"end_time_s", r.end_time_s}};
-}
-
-ClosedLoopResult from_json(const nlohmann::json& j) {
-  ClosedLoopResult r;
-  r.ev_arrived = j.at("ev_arrived");
-  r.ev_travel_time_s = j.at("ev_travel_time_s");
-  r.ev_stops = j.at("ev_stops");
-  r.ev_wait_s = j.at("ev_wait_s");
-  r.ev_time_loss_s = j.at("ev_time_loss_s");
-  r.preempted_signals = j.at("preempted_signals");
-  r.preemptions_started = j.at("preemptions_started");
-  r.preemptions_released = j.at("preemptions_released");
-  r.lights_taken_over = j.at("lights_taken_over");
-  r.lights_back_on_program = j.at("lights_back_on_program");
-  r.safety_violations = j.at("safety_violations").get<std::vector<std::string>>();
-  r.collisions = j.at("collisions");
-  r.teleports = j.at("teleports");
-  r.replans = j.at("replans");
-  r.route_changes = j.at("route_changes");
-  r.congestion_updates = j.at("congestion_updates");
-  r.others_mean_time_loss_s = j.at("others_mean_time_loss_s");
-  r.others = j.at("others");
-  r.end_time_s = j.at("end_time_s");
-  return r;
-}
 
 struct Job {
   ClosedLoopConfig config;
@@ -72,7 +39,7 @@ pid_t start_job(const SumoScenario& scenario, const Job& job) {
   int code = 0;
   try {
     const ClosedLoopResult r = run_closed_loop(scenario, job.config);
-    std::ofstream(job.result_file, std::ios::trunc) << to_json(r).dump();
+    std::ofstream(job.result_file, std::ios::trunc) << nlohmann::json(r).dump();
   } catch (const std::exception& e) {
     std::ofstream(job.result_file, std::ios::trunc) << nlohmann::json{{"error", e.what()}}.dump();
     code = 1;
@@ -90,7 +57,7 @@ ClosedLoopResult finish_job(const Job& job) {
     throw SimError("run " + job.config.run_name + " ended without a result; see " + job.config.out_dir.string());
   }
   if (j.contains("error")) throw SimError("run " + job.config.run_name + " failed: " + j["error"].get<std::string>());
-  return from_json(j);
+  return j.get<ClosedLoopResult>();
 }
 
 double quantile(std::vector<double> v, double q) {

@@ -17,6 +17,30 @@ bool is_yellow(char c) { return c == 'y' || c == 'Y'; }
 bool has_green(const std::string& state) { return state.find_first_of("Gg") != std::string::npos; }
 bool has_yellow(const std::string& state) { return state.find_first_of("yY") != std::string::npos; }
 
+// Every yellow link turned red; `any` tells whether there was one.
+std::string yellow_to_red(std::string state, bool& any) {
+  any = false;
+  for (char& c : state) {
+    if (is_yellow(c)) {
+      c = 'r';
+      any = true;
+    }
+  }
+  return state;
+}
+
+// Every green link that `keep` does not show green turned yellow.
+std::string end_greens(std::string state, const std::string& keep, bool& any) {
+  any = false;
+  for (std::size_t i = 0; i < state.size(); ++i) {
+    if (is_green(state[i]) && !is_green(keep[i])) {
+      state[i] = 'y';
+      any = true;
+    }
+  }
+  return state;
+}
+
 std::string phase_state(const maps::Phase& phase) {
   std::string s(phase.green.size(), 'r');
   for (std::size_t i = 0; i < phase.green.size(); ++i) {
@@ -194,15 +218,11 @@ void SumoSignalController::update(double now_s) {
       const Stage before = l.stage;
       if (l.stage == Stage::clear_yellow) {
         if (now_s < l.wait_until_s) break;
-        std::string s = l.shown;
         bool any = false;
+        std::string s = end_greens(l.shown, l.target, any);
+        // A permissive green the held phase keeps becomes a protected one.
         for (std::size_t i = 0; i < s.size(); ++i) {
-          if (is_green(s[i]) && l.target[i] != 'G') {
-            s[i] = 'y';
-            any = true;
-          } else if (is_green(s[i])) {
-            s[i] = 'G';
-          }
+          if (s[i] == 'g') s[i] = 'G';
         }
         if (any) show(l, s, now_s);
         const bool yellow_left = l.shown.find_first_of("yY") != std::string::npos;
@@ -212,14 +232,8 @@ void SumoSignalController::update(double now_s) {
         l.wait_until_s = yellow_left ? now_s + l.plan->yellow_s : now_s;
       } else if (l.stage == Stage::clear_all_red) {
         if (now_s < l.wait_until_s) break;
-        std::string s = l.shown;
         bool any = false;
-        for (char& c : s) {
-          if (is_yellow(c)) {
-            c = 'r';
-            any = true;
-          }
-        }
+        const std::string s = yellow_to_red(l.shown, any);
         if (any) show(l, s, now_s);
         l.stage = Stage::held;
         l.wait_until_s = any ? now_s + l.plan->all_red_s : now_s;
@@ -246,28 +260,16 @@ void SumoSignalController::update(double now_s) {
       } else if (l.stage == Stage::back_yellow) {
         if (now_s < l.wait_until_s) break;
         const std::string& resume = l.sumo_phases[static_cast<std::size_t>(l.resume_sumo_phase)].state;
-        std::string s = l.shown;
         bool any = false;
-        for (std::size_t i = 0; i < s.size(); ++i) {
-          if (is_green(s[i]) && !is_green(resume[i])) {
-            s[i] = 'y';
-            any = true;
-          }
-        }
+        const std::string s = end_greens(l.shown, resume, any);
         if (any) show(l, s, now_s);
         l.stage = Stage::back_all_red;
         l.stage_start_s = now_s;
         l.wait_until_s = any ? now_s + l.plan->yellow_s : now_s;
       } else if (l.stage == Stage::back_all_red) {
         if (now_s < l.wait_until_s) break;
-        std::string s = l.shown;
         bool any = false;
-        for (char& c : s) {
-          if (is_yellow(c)) {
-            c = 'r';
-            any = true;
-          }
-        }
+        const std::string s = yellow_to_red(l.shown, any);
         if (any) {
           show(l, s, now_s);
           l.wait_until_s = now_s + l.plan->all_red_s;
