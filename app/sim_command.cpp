@@ -30,6 +30,7 @@ struct SimOptions {
   double end_s = 1800.0;
   double congestion_period_s = 10.0;
   std::uint32_t incidents = 2;
+  bool libsumo = false;
 };
 
 sim::EvRouting parse_routing(const std::string& s) {
@@ -62,6 +63,7 @@ void run_sim(const SimOptions& o) {
   c.seed = o.seed;
   c.congestion_period_s = o.congestion_period_s;
   c.incidents = o.incidents;
+  c.backend = o.libsumo ? sim::SumoBackend::libsumo : sim::SumoBackend::traci;
   c.background_routes = sim::build_background_demand(net, {o.volume, o.demand_end_s, o.seed});
   c.out_dir = net.dir / "runs";
   c.run_name = std::string(sim::to_string(c.routing)) + "_" + sim::to_string(c.signals);
@@ -96,6 +98,7 @@ void register_sim_command(CLI::App& app) {
   cmd->add_option("--congestion-period-s", o->congestion_period_s, "how often measured travel times reach the planner")
       ->capture_default_str();
   cmd->add_option("--incidents", o->incidents, "speed drops on the EV's route after it left")->capture_default_str();
+  cmd->add_flag("--libsumo", o->libsumo, "run SUMO in this process (libsumo) instead of over TraCI (libtraci)");
   cmd->callback([o] { run_sim(*o); });
 }
 
@@ -117,7 +120,10 @@ void register_sumo_experiment(CLI::App& experiment) {
       ->capture_default_str();
   cmd->add_option("--incidents", o->incidents, "speed drops on the EV's route after it left")->capture_default_str();
   cmd->add_option("--parallel", o->parallel, "SUMO runs at a time")->capture_default_str();
-  cmd->callback([o, volumes] {
+  auto libsumo = std::make_shared<bool>(false);
+  cmd->add_flag("--libsumo", *libsumo, "run SUMO inside each run's process (libsumo) instead of over TraCI");
+  cmd->callback([o, volumes, libsumo] {
+    o->backend = *libsumo ? sim::SumoBackend::libsumo : sim::SumoBackend::traci;
     o->volumes.clear();
     std::string item;
     for (std::size_t i = 0; i <= volumes->size(); ++i) {

@@ -10,16 +10,14 @@ find_library(SUMO_LIBTRACICPP_LIBRARY NAMES tracicpp libtracicpp)
 find_library(SUMO_LIBSUMOCPP_LIBRARY NAMES sumocpp libsumocpp)
 
 include(FindPackageHandleStandardArgs)
-find_package_handle_standard_args(SUMO REQUIRED_VARS SUMO_LIBTRACICPP_LIBRARY SUMO_INCLUDE_DIR)
+find_package_handle_standard_args(SUMO REQUIRED_VARS SUMO_LIBTRACICPP_LIBRARY SUMO_LIBSUMOCPP_LIBRARY SUMO_INCLUDE_DIR)
 
 if(SUMO_FOUND AND NOT TARGET SUMO::libtracicpp)
   add_library(SUMO::libtracicpp UNKNOWN IMPORTED)
   set_target_properties(SUMO::libtracicpp PROPERTIES IMPORTED_LOCATION "${SUMO_LIBTRACICPP_LIBRARY}"
                         INTERFACE_INCLUDE_DIRECTORIES "${SUMO_INCLUDE_DIR}")
-  if(SUMO_LIBSUMOCPP_LIBRARY)
-    add_library(SUMO::libsumocpp UNKNOWN IMPORTED)
-    set_target_properties(SUMO::libsumocpp PROPERTIES IMPORTED_LOCATION "${SUMO_LIBSUMOCPP_LIBRARY}"
-                          INTERFACE_INCLUDE_DIRECTORIES "${SUMO_INCLUDE_DIR}")
-  endif()
+  add_library(SUMO::libsumocpp UNKNOWN IMPORTED)
+  set_target_properties(SUMO::libsumocpp PROPERTIES IMPORTED_LOCATION "${SUMO_LIBSUMOCPP_LIBRARY}"
+                        INTERFACE_INCLUDE_DIRECTORIES "${SUMO_INCLUDE_DIR}")
 endif()
 mark_as_advanced(SUMO_INCLUDE_DIR SUMO_LIBTRACICPP_LIBRARY SUMO_LIBSUMOCPP_LIBRARY)

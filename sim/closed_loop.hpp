@@ -16,12 +16,16 @@
 namespace corridor::sim {
 
 enum class EvRouting { static_route, dynamic_route };
+// How Corridor talks to SUMO: TraCI over a socket to a sumo process (libtracicpp), or SUMO inside
+// this process (libsumocpp): faster for batch runs, and one simulation per process.
+enum class SumoBackend { traci, libsumo };
 enum class EvSignals { none, bluelight, corridor };
 const char* to_string(EvRouting r);
 const char* to_string(EvSignals s);
 
 struct ClosedLoopConfig {
   bool with_ev = true;  // false: the baseline run for other vehicles' delay
+  SumoBackend backend = SumoBackend::traci;
   EvRouting routing = EvRouting::dynamic_route;
   EvSignals signals = EvSignals::corridor;
   std::string ev_from;  // SUMO edge ids

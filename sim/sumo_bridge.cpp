@@ -23,21 +23,26 @@ std::atomic<int> bridge_counter{0};
 
 }  // namespace
 
+std::vector<std::string> sumo_command(const SumoLaunch& launch, std::optional<int> port) {
+  std::vector<std::string> cmd{launch.sumo_binary, "-n", launch.net.string()};
+  if (!launch.routes.empty()) cmd.insert(cmd.end(), {"-r", join_paths(launch.routes)});
+  if (!launch.additional.empty()) cmd.insert(cmd.end(), {"-a", join_paths(launch.additional)});
+  if (!launch.tripinfo.empty()) {
+    cmd.insert(cmd.end(), {"--tripinfo-output", launch.tripinfo.string(), "--tripinfo-output.write-unfinished", "true"});
+  }
+  cmd.insert(cmd.end(), {"--step-length", fmt::format("{:g}", launch.step_length_s), "--end", fmt::format("{:g}", launch.end_s),
+                         "--seed", std::to_string(launch.seed), "--no-step-log", "true", "--duration-log.disable", "true",
+                         "--collision.action", "warn", "--time-to-teleport", "300", "--ignore-route-errors", "true"});
+  if (port) cmd.insert(cmd.end(), {"--remote-port", std::to_string(*port), "--num-clients", "1"});
+  return cmd;
+}
+
 SumoBridge::SumoBridge(const SumoLaunch& launch) : log_(launch.log) {
   // A port found free can be taken by someone else before SUMO binds it; then SUMO exits, and a
   // fresh port is tried.
   for (int attempt = 1;; ++attempt) {
     const int port = free_tcp_port();
-    std::vector<std::string> cmd{launch.sumo_binary, "-n", launch.net.string()};
-    if (!launch.routes.empty()) cmd.insert(cmd.end(), {"-r", join_paths(launch.routes)});
-    if (!launch.additional.empty()) cmd.insert(cmd.end(), {"-a", join_paths(launch.additional)});
-    if (!launch.tripinfo.empty()) {
-      cmd.insert(cmd.end(), {"--tripinfo-output", launch.tripinfo.string(), "--tripinfo-output.write-unfinished", "true"});
-    }
-    cmd.insert(cmd.end(), {"--step-length", fmt::format("{:g}", launch.step_length_s), "--end", fmt::format("{:g}", launch.end_s),
-                           "--seed", std::to_string(launch.seed), "--no-step-log", "true", "--duration-log.disable", "true",
-                           "--collision.action", "warn", "--time-to-teleport", "300", "--ignore-route-errors", "true",
-                           "--remote-port", std::to_string(port), "--num-clients", "1"});
+    const std::vector<std::string> cmd = sumo_command(launch, port);
     process_ = std::make_unique<ChildProcess>(cmd, log_);
     if (!wait_until_listening(port, *process_, 60.0)) {
       process_->kill();

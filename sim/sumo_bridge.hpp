@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,9 @@ struct SumoLaunch {
   std::uint64_t seed = 1;
   std::string sumo_binary = "sumo";
 };
+
+// The sumo command line for a launch; with a port, SUMO waits there for one TraCI client.
+std::vector<std::string> sumo_command(const SumoLaunch& launch, std::optional<int> port);
 
 class SumoBridge {
  public:

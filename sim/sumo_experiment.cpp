@@ -103,6 +103,7 @@ std::vector<ExperimentRow> run_sumo_experiment(const SumoExperimentOptions& o) {
       base.seed = seed;
       base.congestion_period_s = o.congestion_period_s;
       base.incidents = o.incidents;
+      base.backend = o.backend;
       base.out_dir = o.out_dir / "runs" / fmt::format("v{:g}_s{}", volume, seed);
       ClosedLoopConfig baseline = base;
       baseline.with_ev = false;

@@ -24,6 +24,7 @@ struct SumoExperimentOptions {
   double congestion_period_s = 10.0;
   std::uint32_t incidents = 2;
   unsigned parallel = 2;
+  SumoBackend backend = SumoBackend::traci;
 };
 
 struct ExperimentRow {

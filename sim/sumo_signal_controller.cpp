@@ -1,6 +1,5 @@
 #include "sim/sumo_signal_controller.hpp"
 
-#include <libsumo/libtraci.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -50,21 +49,6 @@ std::string phase_state(const maps::Phase& phase) {
 }
 
 }  // namespace
-
-std::string TraciTrafficLights::state(const std::string& tls) { return libtraci::TrafficLight::getRedYellowGreenState(tls); }
-int TraciTrafficLights::phase(const std::string& tls) { return libtraci::TrafficLight::getPhase(tls); }
-double TraciTrafficLights::spent_s(const std::string& tls) {
-  // SUMO 1.15 has no getSpentDuration; the phase's duration minus what is left of it.
-  const double left = libtraci::TrafficLight::getNextSwitch(tls) - now_s;
-  return std::max(0.0, libtraci::TrafficLight::getPhaseDuration(tls) - left);
-}
-void TraciTrafficLights::set_state(const std::string& tls, const std::string& state) {
-  libtraci::TrafficLight::setRedYellowGreenState(tls, state);
-}
-void TraciTrafficLights::set_program(const std::string& tls, const std::string& program_id) {
-  libtraci::TrafficLight::setProgram(tls, program_id);
-}
-void TraciTrafficLights::set_phase(const std::string& tls, int phase) { libtraci::TrafficLight::setPhase(tls, phase); }
 
 SumoSignalController::SumoSignalController(const std::unordered_map<NodeId, maps::SignalPlan>& plans,
                                            const std::unordered_map<NodeId, const maps::SumoSignalPlan*>& sumo,

@@ -26,20 +26,6 @@ class TrafficLightApi {
   virtual void set_phase(const std::string& tls, int phase) = 0;
 };
 
-// libtraci's TrafficLight domain.
-class TraciTrafficLights final : public TrafficLightApi {
- public:
-  std::string state(const std::string& tls) override;
-  int phase(const std::string& tls) override;
-  double spent_s(const std::string& tls) override;
-  void set_state(const std::string& tls, const std::string& state) override;
-  void set_program(const std::string& tls, const std::string& program_id) override;
-  void set_phase(const std::string& tls, int phase) override;
-
-  // The simulation time, needed for spent_s; set by the loop every step.
-  double now_s = 0.0;
-};
-
 class SumoSignalController final : public preemption::SignalController {
  public:
   // `plans` are keyed by node and must outlive the controller; `sumo` gives each node's light.

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The SUMO closed loop end to end, on a small grid and on Monaco: the EV arrives, at least one
 # preemption starts and is released, every preempted light is back on its program, no collision,
-# no safety violation, and the same seed gives the same numbers.
+# no safety violation, the same seed gives the same numbers, and libsumo agrees with libtraci.
 # Usage: closed_loop_test.sh CORRIDOR_BINARY SHARED_DATA_DIR
 set -euo pipefail
 corridor=$1
@@ -40,6 +40,15 @@ PY
 
 check grid grid --volume 400 --seed 3
 check monaco "$data/osm/monaco.osm.gz" --volume 400 --seed 2
+
+# libsumo (SUMO in-process) and libtraci (SUMO over a socket) run the same simulation.
+"$corridor" sim --scenario grid --work-dir "$work/grid" --routing dynamic --signals corridor --volume 400 --seed 3 \
+  --libsumo > "$work/grid.libsumo.json"
+if ! cmp -s "$work/grid.1.json" "$work/grid.libsumo.json"; then
+  echo "FAIL: libsumo and libtraci runs differ:"
+  diff "$work/grid.1.json" "$work/grid.libsumo.json" || true
+  failures=$((failures + 1))
+fi
 
 # A SUMO that cannot start gives a clear error, not a hang.
 set +e
