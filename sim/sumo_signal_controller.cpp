@@ -184,6 +184,18 @@ void SumoSignalController::begin_return(Light& l, double now_s) {
   update(now_s);
 }
 
+void SumoSignalController::restore_program(Light& l, double now_s) {
+  // getProgram answers "online" after setRedYellowGreenState: restore the id saved from the net,
+  // then restart at a defined phase.
+  api_.set_program(l.tls, l.program_id);
+  api_.set_phase(l.tls, l.resume_sumo_phase);
+  l.stage = Stage::program;
+  l.shown.clear();
+  l.release_pending = false;
+  ++programs_restored_;
+  spdlog::debug("event=signal_restored tls={} t={:.1f} phase={}", l.tls, now_s, l.resume_sumo_phase);
+}
+
 void SumoSignalController::release(NodeId node, std::size_t resume_step, double now_s) {
   Light& l = light(node);
   now_s_ = now_s;
@@ -227,13 +239,7 @@ void SumoSignalController::update(double now_s) {
         if (l.held_since_s < 0.0) {
           if (now_s < l.wait_until_s) break;
           if (l.release_pending) {
-            // Released before the held green was shown: straight back to the program.
-            api_.set_program(l.tls, l.program_id);
-            api_.set_phase(l.tls, l.resume_sumo_phase);
-            l.stage = Stage::program;
-            l.shown.clear();
-            l.release_pending = false;
-            ++programs_restored_;
+            restore_program(l, now_s);  // released before the held green was shown
             break;
           }
           show(l, l.target, now_s);
@@ -261,15 +267,7 @@ void SumoSignalController::update(double now_s) {
           // Stay in back_all_red with nothing yellow: the next pass hands the light back.
           break;
         }
-        // getProgram answers "online" after setRedYellowGreenState: restore the id saved from the
-        // net, then restart at a defined phase.
-        api_.set_program(l.tls, l.program_id);
-        api_.set_phase(l.tls, l.resume_sumo_phase);
-        l.stage = Stage::program;
-        l.shown.clear();
-        l.release_pending = false;
-        ++programs_restored_;
-        spdlog::debug("event=signal_restored tls={} t={:.1f} phase={}", l.tls, now_s, l.resume_sumo_phase);
+        restore_program(l, now_s);
         break;
       }
       if (l.stage == before) break;

@@ -79,6 +79,7 @@ class SumoSignalController final : public preemption::SignalController {
   const Light& light(NodeId node) const;
   void show(Light& l, const std::string& state, double now_s);
   void begin_return(Light& l, double now_s);
+  void restore_program(Light& l, double now_s);
   [[nodiscard]] int sumo_phase_of_step(const Light& l, std::size_t step) const;
   [[nodiscard]] double program_min_green_left_s(Light& l) const;
 

@@ -63,6 +63,22 @@ ExperimentSpec named_spec(std::string id, std::string title) {
   return spec;
 }
 
+// Fig. 8b (queue delay fixed at 7 min, signal delay random) and Fig. 9 (both random) from the
+// protocol of `base`, whose signal delay is fixed at 3 min and queue delay random.
+void add_delay_variants(std::vector<ExperimentSpec>& specs, const ExperimentSpec& base, const std::string& suffix) {
+  ExperimentSpec fig8b = base;
+  fig8b.id = "fig8b";
+  fig8b.title = "queue delay 7 min, signal delay 0-3 min" + suffix;
+  fig8b.signal = {0.0, 180.0};
+  fig8b.queue = {420.0, 420.0};
+  specs.push_back(fig8b);
+  ExperimentSpec fig9 = base;
+  fig9.id = "fig9";
+  fig9.title = "signal delay 0-3 min and queue delay 0-7 min" + suffix;
+  fig9.signal = {0.0, 180.0};
+  specs.push_back(fig9);
+}
+
 const std::vector<double> kLevelsMin{0, 1, 2, 3, 4, 5, 6, 7};
 
 double increase_pct(double travel_s, double base_s) { return (travel_s - base_s) / base_s * 100.0; }
@@ -314,17 +330,7 @@ std::vector<ExperimentReport> run_graph_experiments(const AnalyticalGraph& g, co
     fig8a.runs = options.runs;
     fig8a.plot = Plot::bars_minutes;
     specs.push_back(fig8a);
-    ExperimentSpec fig8b = fig8a;
-    fig8b.id = "fig8b";
-    fig8b.title = "queue delay 7 min, signal delay 0-3 min, " + pair;
-    fig8b.signal = {0.0, 180.0};
-    fig8b.queue = {420.0, 420.0};
-    specs.push_back(fig8b);
-    ExperimentSpec fig9 = fig8a;
-    fig9.id = "fig9";
-    fig9.title = "signal delay 0-3 min and queue delay 0-7 min, " + pair;
-    fig9.signal = {0.0, 180.0};
-    specs.push_back(fig9);
+    add_delay_variants(specs, fig8a, ", " + pair);
   }
   std::vector<ExperimentReport> reports;
   for (const ExperimentSpec& spec : specs) reports.push_back(run_experiment(ctx, spec, options));
@@ -360,17 +366,7 @@ std::vector<ExperimentReport> run_map_experiments(const maps::RoadGraph& graph, 
   fig7.plot = Plot::cdf_percent;
   specs.push_back(fig7);
   // Fig. 8a's protocol is Fig. 7's once every trip has its own pair and links; it is not repeated.
-  ExperimentSpec fig8b = fig7;
-  fig8b.id = "fig8b";
-  fig8b.title = "queue delay 7 min, signal delay 0-3 min";
-  fig8b.signal = {0.0, 180.0};
-  fig8b.queue = {420.0, 420.0};
-  specs.push_back(fig8b);
-  ExperimentSpec fig9 = fig7;
-  fig9.id = "fig9";
-  fig9.title = "signal delay 0-3 min and queue delay 0-7 min";
-  fig9.signal = {0.0, 180.0};
-  specs.push_back(fig9);
+  add_delay_variants(specs, fig7, "");
   std::vector<ExperimentReport> reports;
   for (const ExperimentSpec& spec : specs) reports.push_back(run_experiment(ctx, spec, options));
   return reports;
