@@ -33,12 +33,18 @@ maps::Phase synthesize(const maps::SignalPlan& plan, std::size_t movement) {
   phase.green.assign(plan.movements.size(), 0);
   phase.green[movement] = 1;
   phase.min_green_s = plan.phases.empty() ? 5.0 : plan.phases.front().min_green_s;
-  for (std::size_t m = 0; m < plan.movements.size(); ++m) {
-    if (plan.movements[m].from != plan.movements[movement].from || phase.green[m]) continue;
-    bool compatible = true;
-    for (std::size_t g = 0; g < plan.movements.size(); ++g) compatible = compatible && !(phase.green[g] && plan.conflicts(g, m));
-    if (compatible) phase.green[m] = 1;
-  }
+  auto add_compatible = [&](bool same_approach) {
+    for (std::size_t m = 0; m < plan.movements.size(); ++m) {
+      if ((plan.movements[m].from == plan.movements[movement].from) != same_approach || phase.green[m]) continue;
+      bool compatible = true;
+      for (std::size_t g = 0; g < plan.movements.size(); ++g) compatible = compatible && !(phase.green[g] && plan.conflicts(g, m));
+      if (compatible) phase.green[m] = 1;
+    }
+  };
+  // First the vehicle's own approach, so the queue in front of it moves; then whatever else
+  // conflicts with nothing green, so the hold stops no more traffic than it must.
+  add_compatible(true);
+  add_compatible(false);
   return phase;
 }
 

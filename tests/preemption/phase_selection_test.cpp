@@ -126,5 +126,22 @@ TEST(PhaseSelection, SynthesizesASafePhaseWhenNoPhaseServesTheMovement) {
   EXPECT_TRUE(d.phase.serves(*plan.movement_index(Compass::north, Compass::south)));  // its approach too
 }
 
+TEST(PhaseSelection, SynthesizedPhaseAlsoServesOtherApproachesThatConflictWithNothingGreen) {
+  // North-south and east-west throughs; the program never serves north-south.
+  maps::SignalPlan plan;
+  plan.movements = {{Compass::north, Compass::south}, {Compass::south, Compass::north},
+                    {Compass::east, Compass::west}, {Compass::west, Compass::east}};
+  plan.conflict.assign(16, 0);
+  for (std::size_t a : {0u, 1u}) {
+    for (std::size_t b : {2u, 3u}) plan.conflict[a * 4 + b] = plan.conflict[b * 4 + a] = 1;
+  }
+  plan.phases = {{"EW", {0, 0, 1, 1}, 5.0}};
+  plan.program = {{0, 30.0}};
+  const auto d = select_phase(plan, 0, 0, CongestionLevel::low);
+  EXPECT_FALSE(d.index.has_value());
+  EXPECT_TRUE(plan.phase_is_safe(d.phase));
+  EXPECT_EQ(d.phase.green, (std::vector<std::uint8_t>{1, 1, 0, 0}));  // the opposite through runs too
+}
+
 }  // namespace
 }  // namespace corridor::preemption
