@@ -80,7 +80,8 @@ void run_serve(const ServeOptions& o) {
   const auto now = [] {
     return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
   };
-  server::DispatchService service(graph, {}, &store, now());
+  const std::filesystem::path map_file = o.map.map_file.empty() ? CORRIDOR_DEFAULT_MAP : o.map.map_file;
+  server::DispatchService service(graph, maps::signal_plans_for(map_file, graph), {}, &store, now());
   server::Router router(service, std::move(auth), router_config, now);
   server::HttpServer http(router, service, limits, host, static_cast<unsigned short>(port), o.threads);
   std::cout << "listening on http://" << host << ":" << http.port() << " (map: " << graph.node_count() << " nodes, "

@@ -2,6 +2,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cstdlib>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -31,6 +32,8 @@ struct SimOptions {
   double congestion_period_s = 10.0;
   std::uint32_t incidents = 2;
   bool libsumo = false;
+  std::string server;
+  std::string token;
 };
 
 sim::EvRouting parse_routing(const std::string& s) {
@@ -64,6 +67,13 @@ void run_sim(const SimOptions& o) {
   c.congestion_period_s = o.congestion_period_s;
   c.incidents = o.incidents;
   c.backend = o.libsumo ? sim::SumoBackend::libsumo : sim::SumoBackend::traci;
+  c.server_url = o.server;
+  c.server_token = o.token;
+  if (!o.server.empty() && o.token.empty()) {
+    const char* env = std::getenv("CORRIDOR_TOKEN");
+    if (env == nullptr || *env == '\0') throw UsageError("--server needs --token (or $CORRIDOR_TOKEN) with the dispatcher and vehicle roles");
+    c.server_token = env;
+  }
   c.background_routes = sim::build_background_demand(net, {o.volume, o.demand_end_s, o.seed});
   c.out_dir = net.dir / "runs";
   c.run_name = std::string(sim::to_string(c.routing)) + "_" + sim::to_string(c.signals);
@@ -99,6 +109,9 @@ void register_sim_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--incidents", o->incidents, "speed drops on the EV's route after it left")->capture_default_str();
   cmd->add_flag("--libsumo", o->libsumo, "run SUMO in this process (libsumo) instead of over TraCI (libtraci)");
+  cmd->add_option("--server", o->server,
+                  "run the loop through this corridor serve (http://host:port), started with --map on the same .net.xml");
+  cmd->add_option("--token", o->token, "bearer token for --server (default $CORRIDOR_TOKEN)");
   cmd->callback([o] { run_sim(*o); });
 }
 

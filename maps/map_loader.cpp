@@ -1,5 +1,8 @@
 #include "maps/map_loader.hpp"
 
+#include "maps/intersection_geometry.hpp"
+#include "maps/sumo_graph.hpp"
+
 #include <spdlog/spdlog.h>
 
 #include <chrono>
@@ -25,6 +28,22 @@ std::filesystem::path cache_file_for(const std::filesystem::path& source, const 
   return cache_dir / (stem + "-" + hex + ".cgr");
 }
 
+bool is_sumo_net(const std::filesystem::path& file) {
+  const std::string name = file.filename().string();
+  return name.size() > 8 && name.ends_with(".net.xml");
+}
+
+std::unordered_map<NodeId, SignalPlan> signal_plans_for(const std::filesystem::path& file, const RoadGraph& graph) {
+  if (!is_sumo_net(file)) return default_signal_plans(graph);
+  const SumoNet net = read_sumo_net(file);
+  const SumoGraph sumo = build_sumo_graph(net);
+  if (sumo.graph.node_count() != graph.node_count() || sumo.graph.edge_count() != graph.edge_count()) {
+    throw MapLoadError("'" + file.string() + "' changed since its graph was loaded");
+  }
+  const auto plans = sumo_signal_plans(net);
+  return plans_by_node(sumo, net, plans);
+}
+
 RoadGraph load_map(const std::filesystem::path& file, const MapLoadOptions& options, MapLoadInfo* info) {
   const auto start = std::chrono::steady_clock::now();
   MapLoadInfo local;
@@ -36,6 +55,10 @@ RoadGraph load_map(const std::filesystem::path& file, const MapLoadOptions& opti
 
   std::error_code ec;
   if (!std::filesystem::is_regular_file(file, ec)) throw MapLoadError("map file not found: '" + file.string() + "'");
+  if (is_sumo_net(file)) {
+    // Fast to parse and never cached: the graph must match the net SUMO runs, edge for edge.
+    return finish(build_sumo_graph(read_sumo_net(file)).graph);
+  }
   if (looks_like_graph_cache(file)) {
     local.origin = MapLoadInfo::Origin::cache;
     local.cache_file = file;

@@ -3,9 +3,11 @@
 
 #include <filesystem>
 #include <optional>
+#include <unordered_map>
 
 #include "maps/osm_import.hpp"
 #include "maps/road_graph.hpp"
+#include "maps/signal_plan.hpp"
 
 namespace corridor::maps {
 
@@ -22,8 +24,16 @@ struct MapLoadInfo {
   OsmImportReport import;  // filled when imported
 };
 
-// `file` is an OSM file (.osm, .osm.gz, .osm.bz2, .osm.pbf) or a graph cache written earlier.
+// `file` is an OSM file (.osm, .osm.gz, .osm.bz2, .osm.pbf), a SUMO network (.net.xml: the
+// edge-based graph of maps/sumo_graph.hpp, in the net's own metric frame around lat/lon 0,0), or a
+// graph cache written earlier.
 RoadGraph load_map(const std::filesystem::path& file, const MapLoadOptions& options, MapLoadInfo* info = nullptr);
+
+bool is_sumo_net(const std::filesystem::path& file);
+
+// The signal plans for a map loaded by load_map: SUMO's traffic lights for a SUMO network, NEMA
+// plans at the OSM signals otherwise.
+std::unordered_map<NodeId, SignalPlan> signal_plans_for(const std::filesystem::path& file, const RoadGraph& graph);
 
 // The cache file used for `source` inside `cache_dir`: one per absolute source path.
 std::filesystem::path cache_file_for(const std::filesystem::path& source, const std::filesystem::path& cache_dir);

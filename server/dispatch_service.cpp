@@ -63,12 +63,16 @@ double angle_between_deg(double a, double b) {
 }  // namespace
 
 DispatchService::DispatchService(const maps::RoadGraph& graph, DispatchConfig config, Store* store, double now_s)
+    : DispatchService(graph, maps::default_signal_plans(graph), config, store, now_s) {}
+
+DispatchService::DispatchService(const maps::RoadGraph& graph, std::unordered_map<NodeId, maps::SignalPlan> plans,
+                                 DispatchConfig config, Store* store, double now_s)
     : graph_(graph),
       config_(config),
       store_(store),
       snapper_(graph),
       overlay_(graph),
-      plans_(maps::default_signal_plans(graph)),
+      plans_(std::move(plans)),
       signals_(plans_, now_s),
       preemption_(graph, plans_, signals_, config.preemption) {
   overlay_.set_signal_delay(graph, config_.signal_delay_s);
@@ -451,6 +455,15 @@ std::vector<preemption::Light> DispatchService::signal_lights(NodeId node) const
   std::lock_guard lock(mutex_);
   if (plans_.count(node) == 0) throw not_found("no signal at node " + std::to_string(node.v));
   return signals_.lights(node);
+}
+
+std::pair<std::string, std::size_t> DispatchService::signal_mode(NodeId node) const {
+  std::lock_guard lock(mutex_);
+  if (plans_.count(node) == 0) throw not_found("no signal at node " + std::to_string(node.v));
+  const char* mode = signals_.mode(node) == preemption::SignalMode::held ? "held"
+                     : signals_.running_program(node)                    ? "program"
+                                                                         : "clearing";
+  return {mode, signals_.program_step(node)};
 }
 
 std::size_t DispatchService::active_mission_count() const {

@@ -35,6 +35,9 @@ class DispatchService {
   // `store` may be null (nothing persisted). With a store, active missions and congestion in force
   // are restored. Throws StoreError when the database cannot be read.
   DispatchService(const maps::RoadGraph& graph, DispatchConfig config, Store* store, double now_s);
+  // With the map's own signal plans (for example a SUMO network's traffic lights).
+  DispatchService(const maps::RoadGraph& graph, std::unordered_map<NodeId, maps::SignalPlan> plans, DispatchConfig config,
+                  Store* store, double now_s);
   ~DispatchService();
 
   // Every method validates its input and throws ApiError with a status and a clear message.
@@ -54,6 +57,9 @@ class DispatchService {
   [[nodiscard]] const maps::RoadGraph& graph() const { return graph_; }
   [[nodiscard]] const std::unordered_map<NodeId, maps::SignalPlan>& signal_plans() const { return plans_; }
   [[nodiscard]] std::vector<preemption::Light> signal_lights(NodeId node) const;
+  // "held" (for an emergency vehicle), "clearing" (yellow and all-red on the way back) or
+  // "program", and the program step; a simulator mirrors these onto its own lights.
+  [[nodiscard]] std::pair<std::string, std::size_t> signal_mode(NodeId node) const;
   [[nodiscard]] std::size_t active_mission_count() const;
 
  private:

@@ -153,8 +153,10 @@ Router::Router(DispatchService& service, TokenAuth auth, RouterConfig config, Cl
     const maps::LatLon at = service_.graph().projection().to_lat_lon(service_.graph().position(n));
     json phases = json::array();
     for (const auto& p : plan.phases) phases.push_back(p.label);
+    const auto [mode, step] = service_.signal_mode(n);
     return json{{"id", n.v}, {"osm_node", service_.graph().osm_node(n).v}, {"location", {{"lat", at.lat_deg}, {"lon", at.lon_deg}}},
-                {"phases", std::move(phases)}, {"lights", std::move(lights)}};
+                {"phases", std::move(phases)}, {"lights", std::move(lights)},
+                {"mode", mode}, {"program_step", step}};
   };
   add("GET", "/v1/signals", kRead, "Every signalized intersection", [this, signal_json](const Principal&, const Match&, const HttpRequest&) {
     json list = json::array();

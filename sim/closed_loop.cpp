@@ -105,6 +105,7 @@ std::pair<std::string, std::string> pick_ev_trip(const SumoScenario& scenario, s
 }
 
 ClosedLoopResult run_closed_loop(const SumoScenario& scenario, const ClosedLoopConfig& config) {
+  if (!config.server_url.empty()) return run_closed_loop_server(scenario, config);
   return config.backend == SumoBackend::libsumo ? run_closed_loop_libsumo(scenario, config)
                                                 : run_closed_loop_traci(scenario, config);
 }

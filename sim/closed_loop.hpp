@@ -26,6 +26,10 @@ const char* to_string(EvSignals s);
 struct ClosedLoopConfig {
   bool with_ev = true;  // false: the baseline run for other vehicles' delay
   SumoBackend backend = SumoBackend::traci;
+  // When set, the loop runs through this `corridor serve` (http://host:port), which must serve the
+  // same SUMO net (--map FILE.net.xml); SUMO then keeps wall-clock pace.
+  std::string server_url;
+  std::string server_token;
   EvRouting routing = EvRouting::dynamic_route;
   EvSignals signals = EvSignals::corridor;
   std::string ev_from;  // SUMO edge ids

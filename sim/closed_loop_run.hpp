@@ -30,6 +30,7 @@ namespace corridor::sim {
 
 ClosedLoopResult run_closed_loop_traci(const SumoScenario& scenario, const ClosedLoopConfig& config);
 ClosedLoopResult run_closed_loop_libsumo(const SumoScenario& scenario, const ClosedLoopConfig& config);
+ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const ClosedLoopConfig& config);
 
 namespace detail {
 

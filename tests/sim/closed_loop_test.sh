@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The SUMO closed loop end to end, on a small grid and on Monaco: the EV arrives, at least one
 # preemption starts and is released, every preempted light is back on its program, no collision,
-# no safety violation, the same seed gives the same numbers, and libsumo agrees with libtraci.
+# no safety violation, the same seed gives the same numbers, libsumo agrees with libtraci, and the
+# loop also runs through a live `corridor serve` (--server).
 # Usage: closed_loop_test.sh CORRIDOR_BINARY SHARED_DATA_DIR
 set -euo pipefail
 corridor=$1
@@ -47,6 +48,49 @@ check monaco "$data/osm/monaco.osm.gz" --volume 400 --seed 2
 if ! cmp -s "$work/grid.1.json" "$work/grid.libsumo.json"; then
   echo "FAIL: libsumo and libtraci runs differ:"
   diff "$work/grid.1.json" "$work/grid.libsumo.json" || true
+  failures=$((failures + 1))
+fi
+
+# Through a running server (--server): the server plans, replans and preempts; the loop mirrors its
+# held lights onto SUMO. SUMO keeps wall-clock pace, so this uses a 3x3 grid and a short trip.
+netgenerate --grid --grid.number 3 --grid.length 200 --default.lanenumber 2 --default-junction-type traffic_light \
+  --tls.default-type static --no-turnarounds true -o "$work/small.net.xml" > /dev/null 2>&1
+port=$(/usr/bin/python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
+token=closed-loop-test-token-0123456789
+CORRIDOR_DEV_TOKEN=$token "$corridor" serve --map "$work/small.net.xml" --db "$work/server.db" \
+  --listen "127.0.0.1:$port" > "$work/serve.log" 2>&1 &
+server_pid=$!
+trap 'kill $server_pid 2> /dev/null; rm -rf "$work"' EXIT
+for _ in $(seq 1 100); do
+  curl -sf -H "Authorization: Bearer $token" "http://127.0.0.1:$port/v1/health" > /dev/null && break
+  sleep 0.1
+done
+"$corridor" sim --scenario "$work/small.net.xml" --work-dir "$work/server-run" --volume 300 --seed 1 --ev-depart-s 5 \
+  --server "http://127.0.0.1:$port" --token "$token" > "$work/server.json"
+if ! /usr/bin/python3 - "$work/server.json" <<'PY'
+import json, sys
+a = json.load(open(sys.argv[1]))
+problems = []
+if not a["ev_arrived"]: problems.append("the EV did not arrive")
+if a["preempted_signals"] < 1: problems.append("the server held no light")
+if a["lights_taken_over"] < 1 or a["lights_back_on_program"] != a["lights_taken_over"]:
+    problems.append(f"lights back on program {a['lights_back_on_program']} of {a['lights_taken_over']}")
+if a["collisions"] != 0: problems.append(f"{a['collisions']} collisions")
+print(f"server: travel {a['ev_travel_time_s']} s, stops {a['ev_stops']}, lights held {a['preempted_signals']}")
+for p in problems: print(f"FAIL server: {p}")
+sys.exit(1 if problems else 0)
+PY
+then
+  failures=$((failures + 1))
+fi
+# A server on another map is refused with a clear message.
+set +e
+"$corridor" sim --scenario grid --work-dir "$work/wrong" --server "http://127.0.0.1:$port" --token "$token" \
+  > /dev/null 2> "$work/wrong.txt"
+rc=$?
+set -e
+if [[ $rc == 0 ]] || ! grep -q "is not this SUMO network" "$work/wrong.txt"; then
+  echo "FAIL: a server on another map was not refused: $(cat "$work/wrong.txt")"
   failures=$((failures + 1))
 fi
 

@@ -1,0 +1,238 @@
+// The closed loop through a running `corridor serve`: SUMO runs here, at wall-clock pace, and the
+// server does the rest through its HTTP API, as it would for a real vehicle. It gets the EV's
+// positions and the measured congestion, plans and replans the mission, and runs preemption. Its
+// held and clearing lights are mirrored onto SUMO's traffic lights.
+#include <libsumo/libtraci.h>
+
+#include <chrono>
+#include <map>
+#include <thread>
+
+#include "sim/closed_loop_run.hpp"
+#include "sim/corridor_client.hpp"
+
+namespace corridor::sim {
+namespace {
+
+using nlohmann::json;
+
+std::vector<std::string> sumo_route_of(const maps::SumoGraph& sg, const json& mission) {
+  std::vector<std::string> ids;
+  if (!mission.contains("route") || mission["route"].is_null()) return ids;
+  for (const auto& e : mission["route"]["properties"]["edges"]) {
+    const auto arc = e.get<std::uint32_t>();
+    if (arc >= sg.sumo_edge_of_arc.size()) throw SimError("the server's route names an edge this net does not have");
+    ids.push_back(sg.sumo_edge_of_arc[arc]);
+  }
+  return ids;
+}
+
+json position_json(const maps::RoadGraph& g, maps::Point2 p, double heading_deg, double speed_mps, double time_s) {
+  const maps::LatLon at = g.projection().to_lat_lon(p);
+  return {{"lat", at.lat_deg}, {"lon", at.lon_deg}, {"heading_deg", heading_deg}, {"speed_mps", speed_mps},
+          {"timestamp", time_s}, {"source", "gps"}};
+}
+
+double wall_s() { return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count(); }
+
+}  // namespace
+
+ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const ClosedLoopConfig& config) {
+  using namespace detail;
+  if (config.routing != EvRouting::dynamic_route || config.signals != EvSignals::corridor || !config.with_ev) {
+    throw SimError("--server runs the server's own loop: dynamic routing with Corridor preemption and an EV");
+  }
+  const auto& sg = scenario.graph;
+  const auto& g = sg.graph;
+  CorridorClient server(config.server_url, config.server_token);
+  const json map = server.get("/v1/health");
+  if (map["map"]["nodes"] != g.node_count() || map["map"]["edges"] != g.edge_count()) {
+    throw SimError("the server's map (" + map["map"].dump() + ") is not this SUMO network; start it with --map " +
+                   scenario.net_file.string());
+  }
+  std::error_code ec;
+  std::filesystem::create_directories(config.out_dir, ec);
+  const double vmax_mps = config.ev_vmax_kmh / 3.6;
+  const auto starts = points_on(sg, config.ev_from, 0.0);
+  const auto goals = points_on(sg, config.ev_to, std::nullopt);
+  if (starts.empty() || goals.empty()) throw SimError("the EV's start or goal edge is not a drivable edge of the network");
+
+  SumoLaunch launch;
+  launch.net = scenario.net_file;
+  if (!config.background_routes.empty()) launch.routes.push_back(config.background_routes);
+  const auto types = config.out_dir / "ev_types.add.xml";
+  write_ev_types(types, vmax_mps);
+  launch.additional.push_back(types);
+  launch.tripinfo = config.out_dir / (config.run_name + ".tripinfo.xml");
+  launch.log = config.out_dir / (config.run_name + ".sumo.log");
+  launch.end_s = config.end_s;
+  launch.seed = config.seed;
+  SumoBridge bridge(launch);
+
+  libtraci::Simulation::subscribe(std::vector<int>{libsumo::VAR_COLLIDING_VEHICLES_NUMBER, libsumo::VAR_TELEPORT_STARTING_VEHICLES_NUMBER});
+  for (const auto& [id, arcs] : sg.arcs_onto) libtraci::Edge::subscribe(id, {libsumo::VAR_CURRENT_TRAVELTIME});
+  std::vector<double> factor(g.edge_count(), 1.0);
+
+  ClosedLoopResult result;
+  const std::string vehicle = "ev-" + config.run_name;
+  std::optional<std::uint64_t> mission;
+  std::vector<std::string> route;
+  bool ev_added = false, ev_seen = false, ev_done = false;
+  double ev_depart = 0.0;
+  double last_congestion_s = -1e9;
+  std::map<std::uint32_t, std::string> taken_over;  // signal node -> tls, while the server holds it
+  std::set<std::uint32_t> preempted;
+  std::size_t restored = 0;
+  const double wall_start = wall_s();
+  double t = 0.0;
+  for (int step = 0; t < config.end_s; ++step) {
+    // SUMO keeps pace with the wall clock, which the server's schedule runs on.
+    const double due = wall_start + t;
+    if (const double wait = due - wall_s(); wait > 0) std::this_thread::sleep_for(std::chrono::duration<double>(wait));
+    t = bridge.step();
+    const double now = wall_start + t;
+    const auto sim = libtraci::Simulation::getSubscriptionResults();
+    result.collisions += static_cast<int>(as_double(sim, libsumo::VAR_COLLIDING_VEHICLES_NUMBER));
+    result.teleports += static_cast<int>(as_double(sim, libsumo::VAR_TELEPORT_STARTING_VEHICLES_NUMBER));
+
+    if (t - last_congestion_s >= config.congestion_period_s) {
+      last_congestion_s = t;
+      json updates = json::array();
+      for (const auto& [id, values] : libtraci::Edge::getAllSubscriptionResults()) {
+        const auto arcs = sg.arcs(id);
+        if (arcs.empty()) continue;
+        const double tt = as_double(values, libsumo::VAR_CURRENT_TRAVELTIME);
+        if (!std::isfinite(tt) || tt <= 0.0) continue;
+        const double f = std::clamp(tt / (g.length_m(arcs.front()) / g.speed_mps(arcs.front())), 1.0, 50.0);
+        if (std::abs(f - factor[arcs.front().index()]) <= 0.25 * factor[arcs.front().index()]) continue;
+        for (EdgeId arc : arcs) {
+          factor[arc.index()] = f;
+          updates.push_back({{"edge", arc.v}, {"factor", f}});
+        }
+      }
+      if (!updates.empty()) {
+        const json res = server.post("/v1/congestion", {{"updates", updates}});
+        result.congestion_updates += static_cast<std::uint32_t>(updates.size());
+        result.replans += res.value("missions_replanned", 0u);
+      }
+    }
+
+    if (!ev_added && t >= config.ev_depart_s) {
+      // Where the EV stands, then a mission from there: the server snaps with the heading.
+      const EdgeId first = starts.front().edge;
+      const maps::Point2 a = g.point_along(first, 1.0), b = g.point_along(first, 6.0);
+      const double heading = std::fmod(std::atan2(b.x_m - a.x_m, b.y_m - a.y_m) * 180.0 / M_PI + 360.0, 360.0);
+      server.post("/v1/vehicles/" + vehicle + "/position", position_json(g, a, heading, 0.0, now));
+      const maps::LatLon dest = g.projection().to_lat_lon(g.point_along(goals.front().edge, g.length_m(goals.front().edge) - 1.0));
+      const json m = server.post("/v1/missions", {{"vehicle_id", vehicle},
+                                                  {"destination", {{"lat", dest.lat_deg}, {"lon", dest.lon_deg}}},
+                                                  {"priority", 1},
+                                                  {"vmax_kmh", config.ev_vmax_kmh}});
+      mission = m["id"].get<std::uint64_t>();
+      route = sumo_route_of(sg, m);
+      if (route.empty() || route.front() != config.ev_from) {
+        throw SimError("the server planned from '" + (route.empty() ? std::string("nothing") : route.front()) + "', not from the EV's edge '" +
+                       config.ev_from + "'");
+      }
+      libtraci::Route::add("ev_route", route);
+      libtraci::Vehicle::add(kEv, "ev_route", "ev", "now", "best", "base", "max");
+      libtraci::Vehicle::subscribe(kEv, {libsumo::VAR_ROAD_ID, libsumo::VAR_POSITION, libsumo::VAR_ANGLE, libsumo::VAR_SPEED});
+      ev_added = true;
+      ev_depart = t;
+    }
+
+    if (ev_added && !ev_done) {
+      const auto ev = libtraci::Vehicle::getSubscriptionResults(kEv);
+      if (ev.empty()) {
+        if (ev_seen) {
+          ev_done = true;
+          result.ev_arrived = true;
+          result.ev_travel_time_s = t - ev_depart;
+        }
+      } else {
+        ev_seen = true;
+        const std::string road = as_string(ev, libsumo::VAR_ROAD_ID);
+        const auto pos = std::dynamic_pointer_cast<libsumo::TraCIPosition>(ev.at(libsumo::VAR_POSITION));
+        if (!road.empty() && road[0] != ':' && pos) {
+          const json res = server.post("/v1/vehicles/" + vehicle + "/position",
+                                       position_json(g, {pos->x, pos->y}, as_double(ev, libsumo::VAR_ANGLE),
+                                                     as_double(ev, libsumo::VAR_SPEED), now));
+          if (res.value("route_changed", false) && mission) {
+            const auto fresh = sumo_route_of(sg, server.get("/v1/missions/" + std::to_string(*mission)));
+            if (!fresh.empty() && fresh.front() == road && fresh != route) {
+              try {
+                libtraci::Vehicle::setRoute(kEv, fresh);
+                route = fresh;
+                ++result.route_changes;
+              } catch (const libsumo::TraCIException& e) {
+                spdlog::debug("event=set_route_refused t={:.0f} reason=\"{}\"", t, e.what());
+              }
+            }
+          }
+        }
+      }
+    }
+
+    // Mirror the server's signals: held and clearing lights are shown as the server shows them;
+    // back on its program, the light gets SUMO's program again at the server's step.
+    const json signals = server.get("/v1/signals");
+    for (const auto& s : signals["signals"]) {
+      const auto node = s["id"].get<std::uint32_t>();
+      const std::string mode = s["mode"];
+      const auto sp = scenario.sumo_plan_of.find(NodeId{node});
+      if (sp == scenario.sumo_plan_of.end()) continue;
+      // A light is taken over when the server holds it, and followed through the clearance after.
+      if (mode == "held" || (mode == "clearing" && taken_over.contains(node))) {
+        std::string state;
+        for (const auto& l : s["lights"]) {
+          const std::string light = l["light"];
+          state += light == "green" ? 'G' : light == "yellow" ? 'y' : 'r';
+        }
+        libtraci::TrafficLight::setRedYellowGreenState(sp->second->tls_id, state);
+        if (mode == "held") preempted.insert(node);
+        taken_over[node] = sp->second->tls_id;
+      } else if (const auto it = taken_over.find(node); it != taken_over.end()) {
+        const auto& phases = scenario.tls_phases.at(it->second);
+        const auto program_step = s["program_step"].get<std::size_t>();
+        int sumo_phase = 0;
+        for (std::size_t i = 0, k = 0; i < phases.size(); ++i) {
+          const auto& st = phases[i].state;
+          if (st.find_first_of("Gg") == std::string::npos || st.find_first_of("yY") != std::string::npos) continue;
+          if (k++ == program_step) {
+            sumo_phase = static_cast<int>(i);
+            break;
+          }
+        }
+        libtraci::TrafficLight::setProgram(it->second, sp->second->program_id);
+        libtraci::TrafficLight::setPhase(it->second, sumo_phase);
+        taken_over.erase(it);
+        ++restored;
+      }
+    }
+    if (ev_done && taken_over.empty() && step % 10 == 0 && libtraci::Simulation::getMinExpectedNumber() == 0) break;
+    if (ev_done && taken_over.empty() && t > ev_depart + result.ev_travel_time_s + 10.0) break;
+  }
+  result.end_time_s = t;
+  result.preempted_signals = preempted.size();
+  result.preemptions_started = preempted.size();
+  result.preemptions_released = restored;
+  result.lights_taken_over = restored + taken_over.size();
+  result.lights_back_on_program = restored;
+  bridge.close();
+  double loss = 0.0;
+  for (const TripInfo& trip : read_tripinfo(launch.tripinfo)) {
+    if (trip.id == kEv) {
+      if (trip.arrival_s >= 0.0) result.ev_travel_time_s = trip.duration_s;
+      result.ev_stops = trip.waiting_count;
+      result.ev_wait_s = trip.waiting_time_s;
+      result.ev_time_loss_s = trip.time_loss_s;
+      continue;
+    }
+    loss += trip.time_loss_s;
+    ++result.others;
+  }
+  result.others_mean_time_loss_s = result.others > 0 ? loss / static_cast<double>(result.others) : 0.0;
+  return result;
+}
+
+}  // namespace corridor::sim
