@@ -66,6 +66,48 @@ std::vector<planner::EdgePoint> points_on(const maps::SumoGraph& g, const std::s
 }
 
 
+std::vector<Approach> approaches_of(const SumoScenario& scenario) {
+  const auto& sg = scenario.graph;
+  const auto& g = sg.graph;
+  std::vector<Approach> approaches;
+  for (const auto& [node, plan] : scenario.plans) {
+    // A plan node is one approach's stop line.
+    if (g.in_edges(node).empty()) continue;
+    const maps::SumoEdge* se = scenario.net.edge(sg.sumo_edge_of_node[node.index()]);
+    if (se == nullptr) continue;
+    Approach a{node, maps::approach_side(g, g.in_edges(node).front()), {}, 0.0, {}, 0.0, 0.0, 0.0};
+    for (const auto& lane : se->lanes) {
+      a.lanes.push_back(lane.id);
+      a.length_m += lane.length_m;
+    }
+    approaches.push_back(std::move(a));
+  }
+  // The same order in every run, whatever the hash map's.
+  std::sort(approaches.begin(), approaches.end(), [](const Approach& x, const Approach& y) { return x.node < y.node; });
+  return approaches;
+}
+
+void count_lane_vehicles(const libsumo::SubscriptionResults& lanes, std::vector<Approach>& approaches) {
+  for (Approach& a : approaches) {
+    std::set<std::string> now;
+    double halting = 0.0;
+    for (const auto& lane : a.lanes) {
+      const auto it = lanes.find(lane);
+      if (it == lanes.end()) continue;
+      halting += as_double(it->second, libsumo::LAST_STEP_VEHICLE_HALTING_NUMBER);
+      if (const auto ids = it->second.find(libsumo::LAST_STEP_VEHICLE_ID_LIST); ids != it->second.end()) {
+        if (const auto list = std::dynamic_pointer_cast<libsumo::TraCIStringList>(ids->second)) {
+          now.insert(list->value.begin(), list->value.end());
+        }
+      }
+    }
+    for (const auto& v : now) a.arrivals += a.vehicles.contains(v) ? 0.0 : 1.0;
+    for (const auto& v : a.vehicles) a.departures += now.contains(v) ? 0.0 : 1.0;
+    a.vehicles = std::move(now);
+    a.halting = halting;
+  }
+}
+
 }  // namespace detail
 
 const char* to_string(EvRouting r) { return r == EvRouting::static_route ? "static" : "dynamic"; }

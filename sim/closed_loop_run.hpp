@@ -45,6 +45,24 @@ std::vector<std::string> sumo_ids(const maps::SumoGraph& g, std::span<const Edge
 std::vector<planner::EdgePoint> points_on(const maps::SumoGraph& g, const std::string& sumo_edge,
                                           std::optional<double> offset_m);
 
+// One preemptable approach (a stop line a light controls) seen as loop detectors would see it:
+// vehicles entering its lanes are arrivals, vehicles leaving them are departures.
+struct Approach {
+  NodeId node;
+  maps::Compass side;
+  std::vector<std::string> lanes;
+  double length_m = 0.0;
+  std::set<std::string> vehicles;  // on the approach at the last step
+  double halting = 0.0;            // halted at the last step
+  double arrivals = 0.0;           // since the last report
+  double departures = 0.0;
+  // 7.5 m of lane per halted vehicle.
+  [[nodiscard]] double occupancy() const { return length_m > 0.0 ? std::clamp(halting * 7.5 / length_m, 0.0, 1.0) : 0.0; }
+};
+std::vector<Approach> approaches_of(const SumoScenario& scenario);
+// Updates every approach from its lanes' subscription results (vehicle ids and halting counts).
+void count_lane_vehicles(const libsumo::SubscriptionResults& lanes, std::vector<Approach>& approaches);
+
 struct Incident {
   double time_s;
   std::string edge;
@@ -112,26 +130,10 @@ ClosedLoopResult run_loop(const SumoScenario& scenario, const ClosedLoopConfig& 
   Api::Simulation::subscribe(std::vector<int>{libsumo::VAR_COLLIDING_VEHICLES_NUMBER, libsumo::VAR_TELEPORT_STARTING_VEHICLES_NUMBER});
   for (const auto& [id, arcs] : sg.arcs_onto) Api::Edge::subscribe(id, {libsumo::VAR_CURRENT_TRAVELTIME});
   // Halting vehicles on each approach lane of a preemptable light: the congestion classifier's input.
-  struct Approach {
-    NodeId node;
-    maps::Compass side;
-    std::vector<std::string> lanes;
-    double length_m = 0.0;
-  };
-  std::vector<Approach> approaches;
-  for (const auto& [node, plan] : scenario.plans) {
-    // A plan node is one approach's stop line.
-    if (g.in_edges(node).empty()) continue;
-    {
-      const maps::SumoEdge* se = scenario.net.edge(sg.sumo_edge_of_node[node.index()]);
-      if (se == nullptr) continue;
-      Approach a{node, maps::approach_side(g, g.in_edges(node).front()), {}, 0.0};
-      for (const auto& lane : se->lanes) {
-        a.lanes.push_back(lane.id);
-        a.length_m += lane.length_m;
-        Api::Lane::subscribe(lane.id, {libsumo::LAST_STEP_VEHICLE_HALTING_NUMBER});
-      }
-      approaches.push_back(std::move(a));
+  std::vector<Approach> approaches = approaches_of(scenario);
+  for (const Approach& a : approaches) {
+    for (const auto& lane : a.lanes) {
+      Api::Lane::subscribe(lane, {libsumo::LAST_STEP_VEHICLE_HALTING_NUMBER, libsumo::LAST_STEP_VEHICLE_ID_LIST});
     }
   }
 
@@ -167,6 +169,7 @@ ClosedLoopResult run_loop(const SumoScenario& scenario, const ClosedLoopConfig& 
     const auto sim = Api::Simulation::getSubscriptionResults();
     result.collisions += static_cast<int>(as_double(sim, libsumo::VAR_COLLIDING_VEHICLES_NUMBER));
     result.teleports += static_cast<int>(as_double(sim, libsumo::VAR_TELEPORT_STARTING_VEHICLES_NUMBER));
+    count_lane_vehicles(Api::Lane::getAllSubscriptionResults(), approaches);
 
     // Measured travel times become congestion updates every period (the detection system).
     std::vector<EdgeId> changed;
@@ -189,15 +192,12 @@ ClosedLoopResult run_loop(const SumoScenario& scenario, const ClosedLoopConfig& 
         }
       }
       result.congestion_updates += static_cast<std::uint32_t>(changed.size());
-      const auto lanes = Api::Lane::getAllSubscriptionResults();
-      for (const Approach& a : approaches) {
-        double halting = 0.0;
-        for (const auto& lane : a.lanes) {
-          if (const auto it = lanes.find(lane); it != lanes.end()) halting += as_double(it->second, libsumo::LAST_STEP_VEHICLE_HALTING_NUMBER);
-        }
-        // 7.5 m of lane per halted vehicle: halting count as occupancy of the approach.
-        const double occupancy = a.length_m > 0.0 ? std::clamp(halting * 7.5 / a.length_m, 0.0, 1.0) : 0.0;
-        engine.record_measurement(a.node, a.side, occupancy, std::nullopt);
+      for (Approach& a : approaches) {
+        // Detector counts for the queue estimate, and halting vehicles as occupancy where the
+        // estimate has no data yet.
+        engine.record_counts(a.node, a.side, t, a.arrivals, a.departures);
+        a.arrivals = a.departures = 0.0;
+        engine.record_measurement(a.node, a.side, a.occupancy(), std::nullopt);
       }
     }
 

@@ -72,6 +72,12 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
   libtraci::Simulation::subscribe(std::vector<int>{libsumo::VAR_COLLIDING_VEHICLES_NUMBER, libsumo::VAR_TELEPORT_STARTING_VEHICLES_NUMBER});
   for (const auto& [id, arcs] : sg.arcs_onto) libtraci::Edge::subscribe(id, {libsumo::VAR_CURRENT_TRAVELTIME});
   std::vector<double> factor(g.edge_count(), 1.0);
+  std::vector<Approach> approaches = approaches_of(scenario);
+  for (const Approach& a : approaches) {
+    for (const auto& lane : a.lanes) {
+      libtraci::Lane::subscribe(lane, {libsumo::LAST_STEP_VEHICLE_HALTING_NUMBER, libsumo::LAST_STEP_VEHICLE_ID_LIST});
+    }
+  }
 
   ClosedLoopResult result;
   const std::string vehicle = "ev-" + config.run_name;
@@ -94,6 +100,7 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
     const auto sim = libtraci::Simulation::getSubscriptionResults();
     result.collisions += static_cast<int>(as_double(sim, libsumo::VAR_COLLIDING_VEHICLES_NUMBER));
     result.teleports += static_cast<int>(as_double(sim, libsumo::VAR_TELEPORT_STARTING_VEHICLES_NUMBER));
+    count_lane_vehicles(libtraci::Lane::getAllSubscriptionResults(), approaches);
 
     if (t - last_congestion_s >= config.congestion_period_s) {
       last_congestion_s = t;
@@ -109,6 +116,14 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
           factor[arc.index()] = f;
           updates.push_back({{"edge", arc.v}, {"factor", f}});
         }
+      }
+      // The approaches' detector counts, as the sensor role would send them.
+      for (Approach& a : approaches) {
+        if (a.arrivals > 0.0 || a.departures > 0.0) {
+          server.post("/v1/signals/" + std::to_string(a.node.v) + "/counts",
+                      {{"approach", std::string(1, maps::compass_letter(a.side))}, {"arrivals", a.arrivals}, {"departures", a.departures}});
+        }
+        a.arrivals = a.departures = 0.0;
       }
       if (!updates.empty()) {
         const json res = server.post("/v1/congestion", {{"updates", updates}});
