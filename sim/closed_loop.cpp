@@ -87,6 +87,39 @@ std::vector<Approach> approaches_of(const SumoScenario& scenario) {
   return approaches;
 }
 
+SumoLaunch launch_for(const SumoScenario& scenario, const ClosedLoopConfig& config) {
+  SumoLaunch launch;
+  launch.net = scenario.net_file;
+  if (!config.background_routes.empty()) launch.routes.push_back(config.background_routes);
+  const auto types = config.out_dir / "ev_types.add.xml";
+  write_ev_types(types, config.ev_vmax_kmh / 3.6);
+  launch.additional.push_back(types);
+  launch.tripinfo = config.out_dir / (config.run_name + ".tripinfo.xml");
+  launch.log = config.out_dir / (config.run_name + ".sumo.log");
+  launch.end_s = config.end_s;
+  launch.seed = config.seed;
+  std::error_code ec;
+  std::filesystem::remove(launch.tripinfo, ec);
+  std::filesystem::remove(launch.log, ec);
+  return launch;
+}
+
+void add_trip_results(const std::filesystem::path& tripinfo, ClosedLoopResult& result) {
+  double loss = 0.0;
+  for (const TripInfo& trip : read_tripinfo(tripinfo)) {
+    if (trip.id == kEv) {
+      if (trip.arrival_s >= 0.0) result.ev_travel_time_s = trip.duration_s;
+      result.ev_stops = trip.waiting_count;
+      result.ev_wait_s = trip.waiting_time_s;
+      result.ev_time_loss_s = trip.time_loss_s;
+      continue;
+    }
+    loss += trip.time_loss_s;
+    ++result.others;
+  }
+  result.others_mean_time_loss_s = result.others > 0 ? loss / static_cast<double>(result.others) : 0.0;
+}
+
 void count_lane_vehicles(const libsumo::SubscriptionResults& lanes, std::vector<Approach>& approaches) {
   for (Approach& a : approaches) {
     std::set<std::string> now;

@@ -60,6 +60,10 @@ struct Approach {
   [[nodiscard]] double occupancy() const { return length_m > 0.0 ? std::clamp(halting * 7.5 / length_m, 0.0, 1.0) : 0.0; }
 };
 std::vector<Approach> approaches_of(const SumoScenario& scenario);
+// The run's SUMO files: net, background routes, the EV types, tripinfo and log, fresh for the run.
+SumoLaunch launch_for(const SumoScenario& scenario, const ClosedLoopConfig& config);
+// The EV's travel time, stops and waits, and the other vehicles' mean time loss, from tripinfo.
+void add_trip_results(const std::filesystem::path& tripinfo, ClosedLoopResult& result);
 // Updates every approach from its lanes' subscription results (vehicle ids and halting counts).
 void count_lane_vehicles(const libsumo::SubscriptionResults& lanes, std::vector<Approach>& approaches);
 
@@ -109,18 +113,7 @@ ClosedLoopResult run_loop(const SumoScenario& scenario, const ClosedLoopConfig& 
                    "' is not a drivable edge of the network");
   }
 
-  SumoLaunch launch;
-  launch.net = scenario.net_file;
-  if (!config.background_routes.empty()) launch.routes.push_back(config.background_routes);
-  const auto types = config.out_dir / "ev_types.add.xml";
-  write_ev_types(types, vmax_mps);
-  launch.additional.push_back(types);
-  launch.tripinfo = config.out_dir / (config.run_name + ".tripinfo.xml");
-  launch.log = config.out_dir / (config.run_name + ".sumo.log");
-  launch.end_s = config.end_s;
-  launch.seed = config.seed;
-  std::filesystem::remove(launch.tripinfo, ec);
-  std::filesystem::remove(launch.log, ec);
+  const SumoLaunch launch = launch_for(scenario, config);
   Session bridge(launch);
 
   ApiTrafficLights<Api> lights_api;
@@ -317,19 +310,7 @@ ClosedLoopResult run_loop(const SumoScenario& scenario, const ClosedLoopConfig& 
   result.safety_violations = controller.violations();
   bridge.close();
 
-  double loss = 0.0;
-  for (const TripInfo& trip : read_tripinfo(launch.tripinfo)) {
-    if (trip.id == kEv) {
-      if (trip.arrival_s >= 0.0) result.ev_travel_time_s = trip.duration_s;
-      result.ev_stops = trip.waiting_count;
-      result.ev_wait_s = trip.waiting_time_s;
-      result.ev_time_loss_s = trip.time_loss_s;
-      continue;
-    }
-    loss += trip.time_loss_s;
-    ++result.others;
-  }
-  result.others_mean_time_loss_s = result.others > 0 ? loss / static_cast<double>(result.others) : 0.0;
+  add_trip_results(launch.tripinfo, result);
   return result;
 }
 

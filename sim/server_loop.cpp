@@ -52,21 +52,11 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
   }
   std::error_code ec;
   std::filesystem::create_directories(config.out_dir, ec);
-  const double vmax_mps = config.ev_vmax_kmh / 3.6;
   const auto starts = points_on(sg, config.ev_from, 0.0);
   const auto goals = points_on(sg, config.ev_to, std::nullopt);
   if (starts.empty() || goals.empty()) throw SimError("the EV's start or goal edge is not a drivable edge of the network");
 
-  SumoLaunch launch;
-  launch.net = scenario.net_file;
-  if (!config.background_routes.empty()) launch.routes.push_back(config.background_routes);
-  const auto types = config.out_dir / "ev_types.add.xml";
-  write_ev_types(types, vmax_mps);
-  launch.additional.push_back(types);
-  launch.tripinfo = config.out_dir / (config.run_name + ".tripinfo.xml");
-  launch.log = config.out_dir / (config.run_name + ".sumo.log");
-  launch.end_s = config.end_s;
-  launch.seed = config.seed;
+  const SumoLaunch launch = launch_for(scenario, config);
   SumoBridge bridge(launch);
 
   libtraci::Simulation::subscribe(std::vector<int>{libsumo::VAR_COLLIDING_VEHICLES_NUMBER, libsumo::VAR_TELEPORT_STARTING_VEHICLES_NUMBER});
@@ -234,19 +224,7 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
   result.lights_taken_over = restored + taken_over.size();
   result.lights_back_on_program = restored;
   bridge.close();
-  double loss = 0.0;
-  for (const TripInfo& trip : read_tripinfo(launch.tripinfo)) {
-    if (trip.id == kEv) {
-      if (trip.arrival_s >= 0.0) result.ev_travel_time_s = trip.duration_s;
-      result.ev_stops = trip.waiting_count;
-      result.ev_wait_s = trip.waiting_time_s;
-      result.ev_time_loss_s = trip.time_loss_s;
-      continue;
-    }
-    loss += trip.time_loss_s;
-    ++result.others;
-  }
-  result.others_mean_time_loss_s = result.others > 0 ? loss / static_cast<double>(result.others) : 0.0;
+  add_trip_results(launch.tripinfo, result);
   return result;
 }
 
