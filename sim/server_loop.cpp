@@ -19,7 +19,8 @@ using nlohmann::json;
 std::vector<std::string> sumo_route_of(const maps::SumoGraph& sg, const json& mission) {
   std::vector<std::string> ids;
   if (!mission.contains("route") || mission["route"].is_null()) return ids;
-  for (const auto& e : mission["route"]["properties"]["edges"]) {
+  // at() throws on a malformed answer rather than reading what is not there.
+  for (const auto& e : mission.at("route").at("properties").at("edges")) {
     const auto arc = e.get<std::uint32_t>();
     if (arc >= sg.sumo_edge_of_arc.size()) throw SimError("the server's route names an edge this net does not have");
     ids.push_back(sg.sumo_edge_of_arc[arc]);
@@ -45,9 +46,10 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
   const auto& sg = scenario.graph;
   const auto& g = sg.graph;
   CorridorClient server(config.server_url, config.server_token);
-  const json map = server.get("/v1/health");
-  if (map["map"]["nodes"] != g.node_count() || map["map"]["edges"] != g.edge_count()) {
-    throw SimError("the server's map (" + map["map"].dump() + ") is not this SUMO network; start it with --map " +
+  const json health = server.get("/v1/health");
+  const json server_map = health.is_object() ? health.value("map", json::object()) : json::object();
+  if (server_map.value("nodes", std::size_t{0}) != g.node_count() || server_map.value("edges", std::size_t{0}) != g.edge_count()) {
+    throw SimError("the server's map (" + server_map.dump() + ") is not this SUMO network; start it with --map " +
                    scenario.net_file.string());
   }
   std::error_code ec;
@@ -133,7 +135,7 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
                                                   {"destination", {{"lat", dest.lat_deg}, {"lon", dest.lon_deg}}},
                                                   {"priority", 1},
                                                   {"vmax_kmh", config.ev_vmax_kmh}});
-      mission = m["id"].get<std::uint64_t>();
+      mission = m.at("id").get<std::uint64_t>();
       route = sumo_route_of(sg, m);
       if (route.empty() || route.front() != config.ev_from) {
         throw SimError("the server planned from '" + (route.empty() ? std::string("nothing") : route.front()) + "', not from the EV's edge '" +
@@ -181,16 +183,16 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
     // Mirror the server's signals: held and clearing lights are shown as the server shows them;
     // back on its program, the light gets SUMO's program again at the server's step.
     const json signals = server.get("/v1/signals");
-    for (const auto& s : signals["signals"]) {
-      const auto node = s["id"].get<std::uint32_t>();
-      const std::string mode = s["mode"];
+    for (const auto& s : signals.at("signals")) {
+      const auto node = s.at("id").get<std::uint32_t>();
+      const std::string mode = s.at("mode");
       const auto sp = scenario.sumo_plan_of.find(NodeId{node});
       if (sp == scenario.sumo_plan_of.end()) continue;
       // A light is taken over when the server holds it, and followed through the clearance after.
       if (mode == "held" || (mode == "clearing" && taken_over.contains(node))) {
         std::string state;
-        for (const auto& l : s["lights"]) {
-          const std::string light = l["light"];
+        for (const auto& l : s.at("lights")) {
+          const std::string light = l.at("light");
           state += light == "green" ? 'G' : light == "yellow" ? 'y' : 'r';
         }
         libtraci::TrafficLight::setRedYellowGreenState(sp->second->tls_id, state);
@@ -198,7 +200,7 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
         taken_over[node] = sp->second->tls_id;
       } else if (const auto it = taken_over.find(node); it != taken_over.end()) {
         const auto& phases = scenario.tls_phases.at(it->second);
-        const auto program_step = s["program_step"].get<std::size_t>();
+        const auto program_step = s.at("program_step").get<std::size_t>();
         int sumo_phase = 0;
         for (std::size_t i = 0, k = 0; i < phases.size(); ++i) {
           const auto& st = phases[i].state;
