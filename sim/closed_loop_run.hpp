@@ -228,23 +228,6 @@ ClosedLoopResult run_loop(const SumoScenario& scenario, const ClosedLoopConfig& 
       } else {
         ev_seen = true;
         const std::string road = as_string(ev, libsumo::VAR_ROAD_ID);
-        if (as_double(ev, libsumo::VAR_SPEED) < 0.1) {
-          std::string light;
-          if (!road.empty() && road[0] != ':' && sg.stop_line.contains(road)) {
-            const NodeId head = sg.stop_line.at(road);
-            if (const auto it = scenario.sumo_plan_of.find(head); it != scenario.sumo_plan_of.end()) {
-              light = fmt::format("node={} tls={} state={} mode={}", head.v, it->second->tls_id,
-                                  Api::TrafficLight::getRedYellowGreenState(it->second->tls_id),
-                                  controller.mode(head) == preemption::SignalMode::held ? "held" : "program");
-            }
-          }
-          const auto leader = Api::Vehicle::getLeader(kEv, 50.0);
-          const auto tls = Api::Vehicle::getNextTLS(kEv);
-          spdlog::debug("event=ev_halted t={:.0f} road={} pos={:.1f} lane={} {} leader={}@{:.1f} next_tls={}:{} route={}", t, road,
-                        as_double(ev, libsumo::VAR_LANEPOSITION), Api::Vehicle::getLaneID(kEv), light, leader.first,
-                        leader.second, tls.empty() ? "" : tls.front().id, tls.empty() ? ' ' : tls.front().state,
-                        fmt::join(Api::Vehicle::getRoute(kEv), ","));
-        }
         if (!road.empty() && road[0] != ':' && !sg.arcs(road).empty()) {
           if (road != ev_edge && config.signals == EvSignals::corridor) {
             // Onto a new edge: the EV has crossed the stop line of the one it left.

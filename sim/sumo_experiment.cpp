@@ -11,6 +11,7 @@
 #include <fstream>
 #include <map>
 
+#include "planner/experiments/statistics.hpp"
 #include "planner/experiments/svg_chart.hpp"
 #include "sim/errors.hpp"
 #include "sim/result_json.hpp"
@@ -19,6 +20,8 @@
 
 namespace corridor::sim {
 namespace {
+
+using planner::quantile;
 
 constexpr EvRouting kRoutings[] = {EvRouting::static_route, EvRouting::dynamic_route};
 constexpr EvSignals kSignals[] = {EvSignals::none, EvSignals::bluelight, EvSignals::corridor};
@@ -58,15 +61,6 @@ ClosedLoopResult finish_job(const Job& job) {
   }
   if (j.contains("error")) throw SimError("run " + job.config.run_name + " failed: " + j["error"].get<std::string>());
   return j.get<ClosedLoopResult>();
-}
-
-double quantile(std::vector<double> v, double q) {
-  if (v.empty()) return std::nan("");
-  std::sort(v.begin(), v.end());
-  const double pos = q * static_cast<double>(v.size() - 1);
-  const auto lo = static_cast<std::size_t>(std::floor(pos));
-  const auto hi = static_cast<std::size_t>(std::ceil(pos));
-  return v[lo] + (v[hi] - v[lo]) * (pos - static_cast<double>(lo));
 }
 
 std::string label(EvRouting r, EvSignals s) { return fmt::format("{} / {}", to_string(r), to_string(s)); }

@@ -13,6 +13,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "planner/experiments/statistics.hpp"
 #include "planner/experiments/svg_chart.hpp"
 
 namespace corridor::planner {
@@ -82,13 +83,6 @@ void add_delay_variants(std::vector<ExperimentSpec>& specs, const ExperimentSpec
 const std::vector<double> kLevelsMin{0, 1, 2, 3, 4, 5, 6, 7};
 
 double increase_pct(double travel_s, double base_s) { return (travel_s - base_s) / base_s * 100.0; }
-
-double median(std::vector<double> v) {
-  if (v.empty()) return std::nan("");
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 == 1 ? v[n / 2] : (v[n / 2 - 1] + v[n / 2]) / 2.0;
-}
 
 void evaluate(std::vector<Trip>& trips, const maps::RoadGraph& graph, const AnalyticalOptions& options) {
   std::atomic<std::size_t> next{0};
@@ -164,8 +158,8 @@ std::vector<StrategySummary> summarize(const std::vector<Trip>& trips, const Exp
         }
       }
       s.runs = static_cast<std::uint32_t>(travel.size());
-      s.median_travel_s = median(travel);
-      s.median_increase_pct = median(increase);
+      s.median_travel_s = quantile(travel, 0.5);
+      s.median_increase_pct = quantile(increase, 0.5);
       double sum = 0.0;
       for (double v : increase) sum += v;
       s.mean_increase_pct = increase.empty() ? std::nan("") : sum / static_cast<double>(increase.size());

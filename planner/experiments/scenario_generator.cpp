@@ -119,11 +119,7 @@ std::pair<NodeId, NodeId> draw_pair(const maps::RoadGraph& graph, double min_dis
     const NodeId t{rng.below(n)};
     if (s == t || maps::distance_m(graph.position(s), graph.position(t)) < min_distance_m) continue;
     if (graph.out_edges(s).empty() || graph.in_edges(t).empty()) continue;
-    std::vector<EdgePoint> starts;
-    std::vector<EdgePoint> goals;
-    for (EdgeId e : graph.out_edges(s)) starts.push_back({e, 0.0});
-    for (EdgeId e : graph.in_edges(t)) goals.push_back({e, graph.length_m(e)});
-    const Route r = search.run(SearchSpace(cost, std::move(starts), std::move(goals)), true);
+    const Route r = search.run(SearchSpace(cost, node_departures(graph, s), node_arrivals(graph, t)), true);
     if (r.found && r.edges.size() >= min_edges) return {s, t};
   }
   throw std::runtime_error("no start/goal pair found that is far enough apart on this graph");

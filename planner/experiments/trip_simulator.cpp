@@ -11,18 +11,6 @@
 namespace corridor::planner {
 namespace {
 
-std::vector<EdgePoint> departures(const maps::RoadGraph& g, NodeId v) {
-  std::vector<EdgePoint> points;
-  for (EdgeId e : g.out_edges(v)) points.push_back({e, 0.0});
-  return points;
-}
-
-std::vector<EdgePoint> arrivals(const maps::RoadGraph& g, NodeId v) {
-  std::vector<EdgePoint> points;
-  for (EdgeId e : g.in_edges(v)) points.push_back({e, g.length_m(e)});
-  return points;
-}
-
 void validate(const maps::RoadGraph& g, const TripScenario& s) {
   const auto n = g.node_count();
   if (!s.source.valid() || s.source.index() >= n || !s.destination.valid() || s.destination.index() >= n) {
@@ -115,7 +103,7 @@ class Vehicle {
 };
 
 Route plan_once(const TravelCost& cost, NodeId source, NodeId destination) {
-  const SearchSpace space(cost, departures(cost.graph(), source), arrivals(cost.graph(), destination));
+  const SearchSpace space(cost, node_departures(cost.graph(), source), node_arrivals(cost.graph(), destination));
   OneToOneSearch search;
   Route route = search.run(space, /*use_heuristic=*/false);
   if (!route.found) throw std::invalid_argument("the destination cannot be reached from the source");
@@ -123,6 +111,18 @@ Route plan_once(const TravelCost& cost, NodeId source, NodeId destination) {
 }
 
 }  // namespace
+
+std::vector<EdgePoint> node_departures(const maps::RoadGraph& g, NodeId v) {
+  std::vector<EdgePoint> points;
+  for (EdgeId e : g.out_edges(v)) points.push_back({e, 0.0});
+  return points;
+}
+
+std::vector<EdgePoint> node_arrivals(const maps::RoadGraph& g, NodeId v) {
+  std::vector<EdgePoint> points;
+  for (EdgeId e : g.in_edges(v)) points.push_back({e, g.length_m(e)});
+  return points;
+}
 
 const char* to_string(Routing r) { return r == Routing::static_route ? "static" : "dynamic"; }
 const char* to_string(Signals s) { return s == Signals::preemption ? "preemption" : "none"; }
@@ -152,7 +152,7 @@ TripResult drive_trip(const maps::RoadGraph& graph, const TripScenario& scenario
     return r;
   }
 
-  DStarLite planner(cost, departures(graph, scenario.source), arrivals(graph, scenario.destination));
+  DStarLite planner(cost, node_departures(graph, scenario.source), node_arrivals(graph, scenario.destination));
   planner.replan();
   if (observer) observer(planner, cost);
   Route route = planner.route();

@@ -50,6 +50,11 @@ struct TripResult {
 // Called after every replan of the dynamic strategy, with the planner and the costs it knows.
 using ReplanObserver = std::function<void(const DStarLite& planner, const TravelCost& known)>;
 
+// A trip from node v starts at offset 0 of any of its out-edges, and one to v ends at the end of
+// any of its in-edges.
+std::vector<EdgePoint> node_departures(const maps::RoadGraph& graph, NodeId v);
+std::vector<EdgePoint> node_arrivals(const maps::RoadGraph& graph, NodeId v);
+
 // The delay in force on `edge` at `time_s` under `events` sorted by time.
 double queue_delay_at(std::span<const CongestionEvent> sorted_events, EdgeId edge, double time_s);
 
