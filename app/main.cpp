@@ -13,6 +13,7 @@
 #include "app/route_command.hpp"
 #include "app/serve_command.hpp"
 #include "app/sim_command.hpp"
+#include "app/vo_command.hpp"
 #include "maps/errors.hpp"
 #include "server/store.hpp"
 
@@ -33,6 +34,7 @@ int main(int argc, char** argv) {
   corridor::app::register_serve_command(app);
   corridor::app::register_experiment_command(app);
   corridor::app::register_sim_command(app);
+  corridor::app::register_vo_command(app);
 
   try {
     app.parse(argc, argv);

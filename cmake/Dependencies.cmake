@@ -12,6 +12,10 @@ find_package(SQLite3 REQUIRED)
 # SUMO 1.15 (packages sumo, sumo-tools): the closed loop talks TraCI through libtracicpp.
 list(APPEND CMAKE_MODULE_PATH "${PROJECT_SOURCE_DIR}/cmake")
 find_package(SUMO REQUIRED)
+# The localizer's stereo odometry: OpenCV 4.6 core modules (no contrib), Eigen and Ceres.
+find_package(OpenCV 4.5 REQUIRED COMPONENTS core imgproc imgcodecs features2d calib3d)
+find_package(Eigen3 3.3 REQUIRED NO_MODULE)
+find_package(Ceres 2.0 REQUIRED)
 
 # Debian ships GeographicLib without a CMake config; find the library and header directly.
 find_library(GEOGRAPHICLIB_LIBRARY NAMES GeographicLib REQUIRED)

@@ -1,0 +1,95 @@
+#include "localizer/vo/kitti_format.hpp"
+
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <fstream>
+
+#include "localizer/vo/errors.hpp"
+
+namespace corridor::localizer {
+namespace {
+namespace fs = std::filesystem;
+
+fs::path temp_dir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("corridor_kitti_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+TEST(StereoCamera, TriangulatesDepthFromDisparity) {
+  const StereoCamera c{700, 700, 320, 240, 0.3};
+  const auto p = c.triangulate(390, 240, 21.0);  // Z = 0.3·700/21 = 10 m; X = 70·10/700 = 1 m
+  EXPECT_NEAR(p.z(), 10.0, 1e-12);
+  EXPECT_NEAR(p.x(), 1.0, 1e-12);
+  EXPECT_NEAR(p.y(), 0.0, 1e-12);
+  const auto uv = c.project(p);
+  EXPECT_NEAR(uv.x(), 390, 1e-9);
+}
+
+TEST(StereoCamera, CalibrationRoundTripsThroughKittiFormat) {
+  const auto d = temp_dir("calib");
+  const StereoCamera c{718.856, 718.856, 607.1928, 185.2157, 0.5371};
+  write_kitti_calibration(d / "calib.txt", c);
+  const auto r = read_kitti_calibration(d / "calib.txt");
+  EXPECT_NEAR(r.fx, c.fx, 1e-9);
+  EXPECT_NEAR(r.cy, c.cy, 1e-9);
+  EXPECT_NEAR(r.baseline_m, c.baseline_m, 1e-9);
+}
+
+TEST(StereoCamera, ReadsTheSharedKittiCalibration) {
+  const fs::path f = fs::path(CORRIDOR_SHARED_DATA_DIR) / "stereo/kitti_clip_1/calib.txt";
+  if (!fs::exists(f)) GTEST_SKIP() << "shared KITTI clip not present";
+  const auto c = read_kitti_calibration(f);
+  EXPECT_NEAR(c.fx, 707.09, 0.01);
+  EXPECT_NEAR(c.baseline_m, 0.537, 0.001);
+}
+
+TEST(StereoCamera, RejectsCalibrationWithoutBaseline) {
+  const auto d = temp_dir("badcalib");
+  std::ofstream(d / "calib.txt") << "P0: 700 0 320 0 0 700 240 0 0 0 1 0\nP1: 700 0 320 0 0 700 240 0 0 0 1 0\n";
+  EXPECT_THROW(read_kitti_calibration(d / "calib.txt"), SequenceError);
+  std::ofstream(d / "short.txt") << "P0: 700 0 320\n";
+  EXPECT_THROW(read_kitti_calibration(d / "short.txt"), SequenceError);
+  EXPECT_THROW(read_kitti_calibration(d / "missing.txt"), SequenceError);
+}
+
+TEST(KittiPoses, RoundTripKeepsEveryEntry) {
+  const auto d = temp_dir("poses");
+  std::vector<Pose> poses(3, Pose::Identity());
+  poses[1].translation() << 1.5, -0.25, 12.0;
+  poses[2].linear() = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  write_kitti_poses(d / "p.txt", poses);
+  const auto r = read_kitti_poses(d / "p.txt");
+  ASSERT_EQ(r.size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_TRUE(r[i].matrix().isApprox(poses[i].matrix(), 1e-8));
+}
+
+TEST(KittiPoses, RejectsAShortRow) {
+  const auto d = temp_dir("badposes");
+  std::ofstream(d / "p.txt") << "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 0 0 1\n";
+  EXPECT_THROW(read_kitti_poses(d / "p.txt"), SequenceError);
+}
+
+TEST(StereoSequence, ExplainsMissingPartsAndMismatchedCounts) {
+  EXPECT_THROW(open_stereo_sequence("/nonexistent/seq"), SequenceError);
+  const auto d = temp_dir("seq");
+  write_kitti_calibration(d / "calib.txt", {700, 700, 320, 240, 0.3});
+  EXPECT_THROW(open_stereo_sequence(d), SequenceError);  // no image_0/
+  fs::create_directories(d / "image_0");
+  fs::create_directories(d / "image_1");
+  std::ofstream(d / "image_0/000000.png") << "x";
+  std::ofstream(d / "image_0/000001.png") << "x";
+  std::ofstream(d / "image_1/000000.png") << "x";
+  try {
+    open_stereo_sequence(d);
+    FAIL() << "mismatched counts accepted";
+  } catch (const SequenceError& e) {
+    EXPECT_NE(std::string(e.what()).find("image_1/ has 1"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace corridor::localizer
