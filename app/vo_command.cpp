@@ -9,6 +9,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <sstream>
 #include <opencv2/imgcodecs.hpp>
 
 #include "app/cli_error.hpp"
@@ -121,6 +122,7 @@ struct RunOptions {
   int max_frames = 0;
   double max_depth_m = 40.0;
   int window = 6;
+  bool ba_inline = false;
 };
 
 OdometryOptions odometry_options(const RunOptions& o) {
@@ -135,6 +137,7 @@ OdometryOptions odometry_options(const RunOptions& o) {
   v.stereo.max_depth_m = o.max_depth_m;
   if (!(o.window >= 3 && o.window <= 30)) throw UsageError("--ba-window must be in [3, 30] frames");
   v.window_frames = o.window;
+  v.ba_in_background = !o.ba_inline;
   v.bundle_adjustment = !o.no_ba;
   v.ba.track_selection = !o.no_track_selection;
   return v;
@@ -367,6 +370,7 @@ void register_vo_command(CLI::App& app) {
   run_cmd->add_option("--max-frames", ro->max_frames, "stop after this many frames (0: all)")->capture_default_str();
   run_cmd->add_option("--max-depth-m", ro->max_depth_m, "farthest stereo point used")->capture_default_str();
   run_cmd->add_option("--ba-window", ro->window, "keyframes in the local BA window")->capture_default_str();
+  run_cmd->add_flag("--ba-inline", ro->ba_inline, "run local BA in line instead of on a second thread (same poses)");
   run_cmd->callback([ro] { run_vo(*ro); });
 
   auto co = std::make_shared<CompareOptions>();

@@ -199,15 +199,19 @@ StereoOdometry::BaJob StereoOdometry::prepare_bundle_adjustment(std::size_t fram
   for (const auto& f : window_) {
     for (const auto& ob : f.observations) ++views[ob.track];
   }
-  // Each point starts from its nearest stereo view (the most accurate depth) in the window.
+  // Each point starts from its nearest stereo view (the most accurate depth) in the window, but
+  // never from the newest frame: a point fixed where the newest pose put it would only pin that
+  // pose to its own first estimate.
   std::unordered_map<std::uint64_t, std::pair<double, Eigen::Vector3d>> seed;
   for (std::size_t w = 0; w < window_.size(); ++w) {
     const auto& f = window_[w];
     job.indices.push_back(f.index);
     job.frames.push_back({trajectory_[f.index], w == 0});
+    const bool newest = w + 1 == window_.size();
     for (const auto& ob : f.observations) {
       if (views[ob.track] < 2) continue;
       job.observations.push_back({static_cast<int>(w), ob.track, ob.pixel, ob.right_u});
+      if (newest) continue;
       auto it = seed.find(ob.track);
       if (it == seed.end() || ob.depth < it->second.first) {
         seed[ob.track] = {ob.depth, trajectory_[f.index] * ob.point_cam};
