@@ -4,9 +4,20 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <stdexcept>
 #include <opencv2/imgproc.hpp>
 
 namespace corridor::localizer {
+namespace {
+
+cv::Mat to_grey(const cv::Mat& image) {
+  if (image.channels() == 1) return image;
+  cv::Mat grey;
+  cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+  return grey;
+}
+
+}  // namespace
 
 StereoOdometry::StereoOdometry(const StereoCamera& camera, const OdometryOptions& options, double frame_rate_hz)
     : camera_(camera), options_(options), detector_(options.detector), frame_rate_hz_(frame_rate_hz) {}
@@ -29,16 +40,11 @@ FrameReport StereoOdometry::process(const cv::Mat& left_in, const cv::Mat& right
   };
   FrameReport report;
   report.index = trajectory_.size();
-  const cv::Mat left = left_in.channels() == 1 ? left_in : [&] {
-    cv::Mat g;
-    cv::cvtColor(left_in, g, cv::COLOR_BGR2GRAY);
-    return g;
-  }();
-  const cv::Mat right = right_in.channels() == 1 ? right_in : [&] {
-    cv::Mat g;
-    cv::cvtColor(right_in, g, cv::COLOR_BGR2GRAY);
-    return g;
-  }();
+  const cv::Mat left = to_grey(left_in);
+  const cv::Mat right = to_grey(right_in);
+  if (left.size() != right.size() || left.depth() != CV_8U) {
+    throw std::invalid_argument("stereo odometry needs two 8-bit images of the same size");
+  }
 
   const auto keypoints = detector_.detect(left);
   std::vector<cv::Point2f> points;

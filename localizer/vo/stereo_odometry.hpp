@@ -64,8 +64,9 @@ class StereoOdometry {
   StereoOdometry(const StereoOdometry&) = delete;
   StereoOdometry& operator=(const StereoOdometry&) = delete;
 
-  // Processes the next pair (8-bit greyscale, same size); returns what happened in this frame. With
-  // BA in the background, the report's BA fields arrive later, in reports().
+  // Processes the next pair (8-bit, grey or BGR, same size; std::invalid_argument otherwise) and
+  // returns what happened in this frame. With BA in the background, the report's BA fields arrive
+  // later, in reports().
   FrameReport process(const cv::Mat& left8, const cv::Mat& right8);
 
   // Waits for a window adjustment still running and applies it.

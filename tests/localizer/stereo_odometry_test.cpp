@@ -110,5 +110,12 @@ TEST_F(StereoOdometryOnSynthetic, AbsoluteOrientationAlsoTracksTheDrive) {
   EXPECT_LT(m.drift_pct, 5.0);
 }
 
+TEST(StereoOdometry, RejectsAPairOfDifferentSizes) {
+  StereoOdometry vo({700, 700, 320, 240, 0.3}, {}, 10.0);
+  const cv::Mat left(480, 640, CV_8U, cv::Scalar(0)), right(240, 320, CV_8U, cv::Scalar(0));
+  EXPECT_THROW(vo.process(left, right), std::invalid_argument);
+  EXPECT_TRUE(vo.trajectory().empty());
+}
+
 }  // namespace
 }  // namespace corridor::localizer
