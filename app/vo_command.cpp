@@ -41,17 +41,6 @@ struct SynthOptions {
   double min_turn_deg = 180.0;
 };
 
-double total_turn_deg(const std::vector<maps::Point2>& line) {
-  const auto smooth = synth::smooth_polyline(line, 4.0, 2.0);
-  double sum = 0;
-  for (std::size_t i = 2; i < smooth.size(); ++i) {
-    const double a = std::atan2(smooth[i - 1].y_m - smooth[i - 2].y_m, smooth[i - 1].x_m - smooth[i - 2].x_m);
-    const double b = std::atan2(smooth[i].y_m - smooth[i - 1].y_m, smooth[i].x_m - smooth[i - 1].x_m);
-    sum += std::abs(std::remainder(b - a, 2 * std::numbers::pi));
-  }
-  return sum * 180.0 / std::numbers::pi;
-}
-
 // A real route through the map at least `length_m` long and with real turns, chosen by seed.
 std::vector<maps::Point2> pick_drive(const maps::RoadGraph& graph, const SynthOptions& o) {
   planner::CostOverlay overlay(graph);
@@ -65,7 +54,8 @@ std::vector<maps::Point2> pick_drive(const maps::RoadGraph& graph, const SynthOp
         search.run(planner::SearchSpace(cost, {{a, 0.0}}, {{b, graph.length_m(b)}}), true);
     if (!route.found || route.length_m < o.length_m + 30.0) continue;
     auto line = planner::route_polyline(graph, route);
-    if (total_turn_deg(line) < o.min_turn_deg) continue;
+    // Only the part that will be driven counts: the drive stops after --length-m.
+    if (synth::total_turn_deg(line, synth::DriveOptions{}.corner_smoothing_m, o.length_m) < o.min_turn_deg) continue;
     spdlog::info("vo synth: route of {:.0f} m on attempt {}", route.length_m, attempt + 1);
     return line;
   }
@@ -147,6 +137,7 @@ struct RunResult {
   std::vector<Pose> poses;
   std::vector<FrameReport> frames;
   double seconds = 0.0;  // pipeline only, images already decoded
+  std::vector<Pose> ground_truth;  // the frames run, when the sequence has ground truth
   std::optional<TrajectoryMetrics> metrics;
 };
 
@@ -170,7 +161,8 @@ RunResult run_sequence(const StereoSequence& seq, const OdometryOptions& options
   r.frames = vo.reports();
   r.poses = vo.trajectory();
   if (seq.ground_truth) {
-    std::vector<Pose> gt(seq.ground_truth->begin(), seq.ground_truth->begin() + static_cast<std::ptrdiff_t>(n));
+    auto& gt = r.ground_truth;
+    gt.assign(seq.ground_truth->begin(), seq.ground_truth->begin() + static_cast<std::ptrdiff_t>(n));
     // Drives shorter than KITTI's shortest segment are scored on 10…50 m segments instead.
     double len = 0;
     for (std::size_t i = 1; i < gt.size(); ++i) len += (gt[i].translation() - gt[i - 1].translation()).norm();
@@ -192,8 +184,8 @@ nlohmann::json metrics_json(const RunResult& r) {
   return j;
 }
 
-nlohmann::json summary_json(const RunResult& r) {
-  nlohmann::json j = r.metrics ? metrics_json(r) : nlohmann::json::object();
+nlohmann::json summary_json(const RunResult& r, bool with_metrics) {
+  nlohmann::json j = with_metrics && r.metrics ? metrics_json(r) : nlohmann::json::object();
   int bridged = 0;
   double inliers = 0, before = 0, after = 0;
   int ba_frames = 0;
@@ -254,10 +246,8 @@ void run_vo(const RunOptions& o) {
   const RunResult r = run_sequence(seq, options, o.max_frames);
   write_kitti_poses(o.out, r.poses);
   if (!o.frames_csv.empty()) write_frames_csv(o.frames_csv, r.frames);
-  std::vector<Pose> gt;
-  if (seq.ground_truth) gt.assign(seq.ground_truth->begin(), seq.ground_truth->begin() + static_cast<std::ptrdiff_t>(r.poses.size()));
-  if (!o.plot.empty()) write_trajectory_plot(o.plot, r.poses, gt.empty() ? nullptr : &gt);
-  const nlohmann::json j = summary_json(o.eval ? r : RunResult{{}, r.frames, r.seconds, std::nullopt});
+  if (!o.plot.empty()) write_trajectory_plot(o.plot, r.poses, r.ground_truth.empty() ? nullptr : &r.ground_truth);
+  const nlohmann::json j = summary_json(r, o.eval);
   if (o.json) {
     std::cout << j.dump() << '\n';
     return;
@@ -309,7 +299,7 @@ void run_compare(const CompareOptions& o) {
     options.bundle_adjustment = v.ba;
     options.ba.track_selection = v.track_selection;
     const RunResult r = run_sequence(seq, options, o.max_frames);
-    nlohmann::json j = summary_json(r);
+    nlohmann::json j = summary_json(r, true);
     j["variant"] = v.name;
     rows.push_back(j);
     auto num = [&](const char* key, int digits) {

@@ -59,6 +59,19 @@ std::vector<maps::Point2> smooth_polyline(const std::vector<maps::Point2>& polyl
   return out;
 }
 
+double total_turn_deg(const std::vector<maps::Point2>& polyline, double corner_smoothing_m, double length_m) {
+  constexpr double kStep = 2.0;
+  const auto pts = smooth_polyline(polyline, corner_smoothing_m, kStep);
+  const std::size_t n = std::min(pts.size(), static_cast<std::size_t>(length_m / kStep) + 1);
+  double sum = 0;
+  for (std::size_t i = 2; i < n; ++i) {
+    const double a = std::atan2(pts[i - 1].y_m - pts[i - 2].y_m, pts[i - 1].x_m - pts[i - 2].x_m);
+    const double b = std::atan2(pts[i].y_m - pts[i - 1].y_m, pts[i].x_m - pts[i - 1].x_m);
+    sum += std::abs(wrap_angle(b - a));
+  }
+  return sum * 180.0 / std::numbers::pi;
+}
+
 std::vector<DriveSample> plan_drive(const std::vector<maps::Point2>& polyline, const DriveOptions& o) {
   constexpr double kSpacing = 0.5;
   const auto pts = smooth_polyline(polyline, o.corner_smoothing_m, kSpacing);

@@ -28,6 +28,10 @@ struct DriveSample {
 std::vector<maps::Point2> smooth_polyline(const std::vector<maps::Point2>& polyline, double sigma_m,
                                           double spacing_m = 0.5);
 
+// Total heading change, in degrees, along the first `length_m` of the polyline once its corners are
+// rounded as a drive rounds them: how much a drive of that length turns.
+double total_turn_deg(const std::vector<maps::Point2>& polyline, double corner_smoothing_m, double length_m);
+
 // Throws std::invalid_argument when the polyline is shorter than 20 m.
 std::vector<DriveSample> plan_drive(const std::vector<maps::Point2>& polyline, const DriveOptions& options);
 

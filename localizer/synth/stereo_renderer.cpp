@@ -75,9 +75,11 @@ cv::Mat facade_image(int size, int windows_x, int floors, double albedo, std::mt
   return img;
 }
 
+// Everything about a wall hit that depends only on the column, so rows do not recompute it.
 struct Hit {
-  double depth;  // along the optical axis
-  double s;      // 0..1 along the wall
+  double depth;      // along the optical axis
+  double u_m;        // texture coordinate along the wall
+  double footprint;  // metres of wall per pixel, widened at grazing angles
   const Wall* wall;
 };
 
@@ -156,7 +158,11 @@ cv::Mat StereoRenderer::render(const std::vector<Wall>& walls, const CameraPlace
         const double qx = wall->a.x_m - c.x_m, qy = wall->a.y_m - c.y_m;
         const double t = (qx * ey - qy * ex) / denom;
         const double s = (qx * ray_y - qy * ray_x) / denom;
-        if (t > 0.05 && t < far && s >= 0 && s <= 1) hits.push_back({t, s, wall});
+        if (t > 0.05 && t < far && s >= 0 && s <= 1) {
+          const double len = std::hypot(ex, ey);
+          const double cos_inc = std::abs(ex * ray_y - ey * ray_x) / (len * ray_len);
+          hits.push_back({t, wall->u_offset_m + s * len, t / f / std::sqrt(std::max(cos_inc, 0.15)), wall});
+        }
       }
       std::sort(hits.begin(), hits.end(), [](const Hit& p, const Hit& q) { return p.depth < q.depth; });
       for (int v = 0; v < h; ++v) {
@@ -168,14 +174,9 @@ cv::Mat StereoRenderer::render(const std::vector<Wall>& walls, const CameraPlace
           const double z = cam_h - hit.depth * k;
           if (z < 0 || z > hit.wall->height_m) continue;
           const Wall& wall = *hit.wall;
-          const double len = maps::distance_m(wall.a, wall.b);
-          const double ux = (wall.b.x_m - wall.a.x_m) / len, uy = (wall.b.y_m - wall.a.y_m) / len;
-          const double cos_inc = std::abs(ux * ray_y - uy * ray_x) / ray_len;
-          const double footprint = hit.depth / f / std::sqrt(std::max(cos_inc, 0.15));
-          const double tu = wall.u_offset_m + hit.s * len;
           const Texture& tex = facades_[static_cast<std::size_t>(wall.texture)];
-          const double detail = sample(tex, tu, z, footprint);
-          const double large = sample(overlay_, tu, z, std::max(footprint, 0.3));
+          const double detail = sample(tex, hit.u_m, z, hit.footprint);
+          const double large = sample(overlay_, hit.u_m, z, std::max(hit.footprint, 0.3));
           value = static_cast<float>(255.0 * wall.shade * detail * (0.75 + 0.5 * large));
           break;
         }

@@ -52,12 +52,15 @@ Eigen::Isometry3d from_params(const std::array<double, 6>& p) {
 
 double squared_error(const std::vector<BaFrame>& frames, const std::unordered_map<std::uint64_t, Eigen::Vector3d>& points,
                      const std::vector<BaObservation>& obs, const StereoCamera& c, int& count) {
+  std::vector<Eigen::Isometry3d> world_to_camera;
+  world_to_camera.reserve(frames.size());
+  for (const auto& f : frames) world_to_camera.push_back(f.pose.inverse());
   double sq = 0;
   count = 0;
   for (const auto& o : obs) {
     const auto it = points.find(o.track);
     if (it == points.end()) continue;
-    const Eigen::Vector3d q = frames[static_cast<std::size_t>(o.frame)].pose.inverse() * it->second;
+    const Eigen::Vector3d q = world_to_camera[static_cast<std::size_t>(o.frame)] * it->second;
     if (q.z() <= 1e-3) continue;
     const Eigen::Vector2d uv = c.project(q);
     sq += (uv - o.pixel).squaredNorm();

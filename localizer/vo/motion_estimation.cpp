@@ -81,8 +81,18 @@ MotionEstimate estimate_relative_orientation(const std::vector<Eigen::Vector3d>&
   const bool found = cv::solvePnPRansac(obj, img, camera_matrix(c), cv::noArray(), rvec, tvec, false, o.iterations,
                                         static_cast<float>(threshold_px), o.confidence, inliers, cv::SOLVEPNP_P3P);
   if (!found || static_cast<int>(inliers.size()) < o.min_inliers) return {};
-  // Refine on the inliers, then once more on the inliers of the refined motion.
+  // Refine on RANSAC's inliers, then once more on the inliers of the refined motion; finish()
+  // reports the inliers of the final one.
   for (int pass = 0; pass < 2; ++pass) {
+    if (pass == 1) {
+      const auto m = from_cv(rvec, tvec);
+      inliers.clear();
+      for (int i = 0; i < static_cast<int>(pts.size()); ++i) {
+        if (reprojection_error_px(m, pts[static_cast<std::size_t>(i)], px[static_cast<std::size_t>(i)], c) < threshold_px) {
+          inliers.push_back(i);
+        }
+      }
+    }
     std::vector<cv::Point3d> o_in;
     std::vector<cv::Point2d> i_in;
     for (const int i : inliers) {
@@ -91,13 +101,6 @@ MotionEstimate estimate_relative_orientation(const std::vector<Eigen::Vector3d>&
     }
     if (static_cast<int>(o_in.size()) < o.min_inliers) return {};
     cv::solvePnPRefineLM(o_in, i_in, camera_matrix(c), cv::noArray(), rvec, tvec);
-    const auto m = from_cv(rvec, tvec);
-    inliers.clear();
-    for (int i = 0; i < static_cast<int>(pts.size()); ++i) {
-      if (reprojection_error_px(m, pts[static_cast<std::size_t>(i)], px[static_cast<std::size_t>(i)], c) < threshold_px) {
-        inliers.push_back(i);
-      }
-    }
   }
   return finish(from_cv(rvec, tvec), pts, px, c, threshold_px, o.min_inliers);
 }
