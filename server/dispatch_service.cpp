@@ -36,6 +36,9 @@ struct DispatchService::Mission {
   planner::Route route;
   std::uint32_t revision = 0;
   std::vector<preemption::ScheduleEntry> final_schedule;  // kept when the engine forgets the mission
+  // Set when edge costs changed and the plan has not been repaired since: the reason to give if
+  // the repaired route differs.
+  std::optional<std::string> unrepaired_change;
 };
 
 namespace {
@@ -54,6 +57,12 @@ double bearing_deg(const maps::RoadGraph& g, EdgeId e, double offset_m) {
   const maps::Point2 b = g.point_along(e, std::min(len, offset_m + 1.0));
   return std::fmod(std::atan2(b.x_m - a.x_m, b.y_m - a.y_m) * 180.0 / M_PI + 360.0, 360.0);
 }
+
+// Drops the writes a call staged if it fails half-way: what is not acknowledged is not stored.
+struct DropUnsubmitted {
+  std::vector<CommitQueue::Write>& staged;
+  ~DropUnsubmitted() { staged.clear(); }
+};
 
 double angle_between_deg(double a, double b) {
   const double d = std::fmod(std::abs(a - b), 360.0);
@@ -77,10 +86,34 @@ DispatchService::DispatchService(const maps::RoadGraph& graph, std::unordered_ma
       preemption_(graph, plans_, signals_, config.preemption) {
   overlay_.set_signal_delay(graph, config_.signal_delay_s);
   for (EdgeId e : graph.edges()) edges_by_way_.emplace(graph.osm_way(e).v, e);
-  if (store_ != nullptr) restore(now_s);
+  if (store_ != nullptr) {
+    commits_ = std::make_unique<CommitQueue>(*store_);
+    restore(now_s);
+  }
 }
 
+// Queued writes hold copies of what they store, so the queue may drain after the rest is gone.
 DispatchService::~DispatchService() = default;
+
+void DispatchService::stage(CommitQueue::Write write) {
+  if (commits_) staged_.push_back(std::move(write));
+}
+
+std::shared_ptr<CommitTicket> DispatchService::submit_staged() {
+  if (!commits_ || staged_.empty()) return CommitTicket::done();
+  return commits_->submit([writes = std::exchange(staged_, {})](Store& store) {
+    for (const auto& w : writes) w(store);
+  });
+}
+
+void DispatchService::flush() {
+  if (commits_) commits_->flush();
+}
+
+std::optional<CommitQueue::Stats> DispatchService::commit_stats() const {
+  if (!commits_) return std::nullopt;
+  return commits_->stats();
+}
 
 std::size_t DispatchService::subscribe(Listener listener) {
   std::lock_guard lock(mutex_);
@@ -127,16 +160,17 @@ MissionView DispatchService::view(const Mission& m) const {
 
 void DispatchService::drain_preemption_events() {
   for (const auto& e : preemption_.take_events()) {
-    if (store_ != nullptr) store_->insert_preemption_event(e);
+    stage([e](Store& store) { store.insert_preemption_event(e); });
     emit("preemption_" + e.kind, e.mission, e.detail, e.time_s);
   }
 }
 
 void DispatchService::persist_route(Mission& m, const std::string& reason, double now_s) {
-  if (store_ != nullptr) {
-    const auto feature = planner::route_to_geojson(graph_, m.route, "dstar");
-    store_->insert_route_revision(m.row.id, m.revision + 1, reason, m.route.travel_time_s, m.route.length_m,
-                                  feature["geometry"].dump(), now_s);
+  if (commits_) {
+    stage([id = m.row.id, revision = m.revision + 1, reason, eta = m.route.travel_time_s, length = m.route.length_m,
+           geometry = planner::route_to_geojson(graph_, m.route, "dstar")["geometry"].dump(), now_s](Store& store) {
+      store.insert_route_revision(id, revision, reason, eta, length, geometry, now_s);
+    });
   }
   ++m.revision;
   m.row.updated_s = now_s;
@@ -153,57 +187,67 @@ MissionView DispatchService::create_mission(const MissionRequest& req, double no
   if (req.vehicle_id.empty() || req.vehicle_id.size() > 64) throw bad_request("vehicle_id must be 1 to 64 characters");
   if (!(req.vmax_kmh >= 5.0 && req.vmax_kmh <= 250.0)) throw bad_request("vmax_kmh must be between 5 and 250");
   if (req.priority < 0 || req.priority > 10) throw bad_request("priority must be between 0 and 10");
-  std::lock_guard lock(mutex_);
-  if (active_by_vehicle_.count(req.vehicle_id) != 0) {
-    throw conflict("vehicle '" + req.vehicle_id + "' already has active mission " +
-                   std::to_string(active_by_vehicle_.at(req.vehicle_id)) + "; cancel it first");
-  }
-  std::optional<maps::LatLon> origin = req.origin;
-  if (!origin) {
-    if (auto it = last_position_.find(req.vehicle_id); it != last_position_.end()) origin = it->second;
-  }
-  if (!origin) {
-    throw unprocessable("no_origin", "vehicle '" + req.vehicle_id +
-                                         "' has no known position: post one to /v1/vehicles/{id}/position or give origin");
-  }
-  maps::SnapResult from, to;
-  try {
-    from = snapper_.snap(*origin, {config_.snap_max_distance_m});
-  } catch (const maps::SnapError& e) {
-    throw snap_error(e, "origin");
-  }
-  try {
-    to = snapper_.snap(req.destination, {config_.snap_max_distance_m});
-  } catch (const maps::SnapError& e) {
-    throw snap_error(e, "destination");
-  }
+  std::shared_ptr<CommitTicket> durable;
+  MissionView created;
+  {
+    std::lock_guard lock(mutex_);
+    const DropUnsubmitted drop{staged_};
+    if (active_by_vehicle_.count(req.vehicle_id) != 0) {
+      throw conflict("vehicle '" + req.vehicle_id + "' already has active mission " +
+                     std::to_string(active_by_vehicle_.at(req.vehicle_id)) + "; cancel it first");
+    }
+    std::optional<maps::LatLon> origin = req.origin;
+    if (!origin) {
+      if (auto it = last_position_.find(req.vehicle_id); it != last_position_.end()) origin = it->second;
+    }
+    if (!origin) {
+      throw unprocessable("no_origin", "vehicle '" + req.vehicle_id +
+                                           "' has no known position: post one to /v1/vehicles/{id}/position or give origin");
+    }
+    maps::SnapResult from, to;
+    try {
+      from = snapper_.snap(*origin, {config_.snap_max_distance_m});
+    } catch (const maps::SnapError& e) {
+      throw snap_error(e, "origin");
+    }
+    try {
+      to = snapper_.snap(req.destination, {config_.snap_max_distance_m});
+    } catch (const maps::SnapError& e) {
+      throw snap_error(e, "destination");
+    }
 
-  auto m = std::make_unique<Mission>();
-  m->row = {0, req.vehicle_id, req.priority, req.vmax_kmh, req.destination, origin, MissionState::active, now_s, now_s};
-  m->last_position = origin;
-  m->destination_local = to.point;
-  m->cost = std::make_unique<planner::TravelCost>(graph_, overlay_, planner::VehicleProfile{req.vmax_kmh / 3.6});
-  m->planner = std::make_unique<planner::DStarLite>(*m->cost, endpoints(from, Role::start, std::nullopt),
-                                                          endpoints(to, Role::goal, std::nullopt));
-  m->planner->replan();
-  m->route = m->planner->route();
-  if (!m->route.found) throw unprocessable("unreachable", "the destination cannot be reached from the origin");
+    auto m = std::make_unique<Mission>();
+    m->row = {0, req.vehicle_id, req.priority, req.vmax_kmh, req.destination, origin, MissionState::active, now_s, now_s};
+    m->last_position = origin;
+    m->destination_local = to.point;
+    m->cost = std::make_unique<planner::TravelCost>(graph_, overlay_, planner::VehicleProfile{req.vmax_kmh / 3.6});
+    m->planner = std::make_unique<planner::DStarLite>(*m->cost, endpoints(from, Role::start, std::nullopt),
+                                                            endpoints(to, Role::goal, std::nullopt));
+    m->planner->replan();
+    m->route = m->planner->route();
+    if (!m->route.found) throw unprocessable("unreachable", "the destination cannot be reached from the origin");
 
-  // The database first: if it fails, nothing was shared and the request fails whole.
-  if (store_ != nullptr) {
-    Store::Transaction tx(*store_);
-    m->row.id = store_->insert_mission(m->row);
-    persist_route(*m, "dispatch", now_s);
-    tx.commit();
-  } else {
-    m->row.id = next_memory_id_++;
-    persist_route(*m, "dispatch", now_s);
+    // The database first: if it fails, nothing was shared and the request fails whole.
+    if (commits_) {
+      const std::string geometry = planner::route_to_geojson(graph_, m->route, "dstar")["geometry"].dump();
+      commits_->run([&](Store& store) {
+        m->row.id = store.insert_mission(m->row);
+        store.insert_route_revision(m->row.id, 1, "dispatch", m->route.travel_time_s, m->route.length_m, geometry, now_s);
+      });
+      m->revision = 1;
+    } else {
+      m->row.id = next_memory_id_++;
+      persist_route(*m, "dispatch", now_s);
+    }
+    Mission& ref = *m;
+    missions_[ref.row.id] = std::move(m);
+    active_by_vehicle_[ref.row.vehicle_id] = ref.row.id;
+    announce_route(ref, "dispatch", now_s);
+    durable = submit_staged();
+    created = view(ref);
   }
-  Mission& ref = *m;
-  missions_[ref.row.id] = std::move(m);
-  active_by_vehicle_[ref.row.vehicle_id] = ref.row.id;
-  announce_route(ref, "dispatch", now_s);
-  return view(ref);
+  durable->wait();
+  return created;
 }
 
 MissionView DispatchService::mission(MissionId id) const {
@@ -231,8 +275,8 @@ DispatchService::Mission& DispatchService::active(MissionId id) {
   return *it->second;
 }
 
-void DispatchService::finish(Mission& m, MissionState state, double now_s) {
-  if (store_ != nullptr) store_->update_mission_state(m.row.id, state, now_s);  // may throw: nothing changed yet
+void DispatchService::finish(Mission& m, MissionState state, double now_s, bool stage_state) {
+  if (stage_state) stage([id = m.row.id, state, now_s](Store& store) { store.update_mission_state(id, state, now_s); });
   m.row.state = state;
   m.row.updated_s = now_s;
   active_by_vehicle_.erase(m.row.vehicle_id);
@@ -245,13 +289,20 @@ void DispatchService::finish(Mission& m, MissionState state, double now_s) {
 }
 
 MissionView DispatchService::cancel_mission(MissionId id, double now_s) {
-  std::lock_guard lock(mutex_);
-  Mission& m = active(id);
-  std::optional<Store::Transaction> tx;
-  if (store_ != nullptr) tx.emplace(*store_);
-  finish(m, MissionState::cancelled, now_s);
-  if (tx) tx->commit();
-  return view(m);
+  std::shared_ptr<CommitTicket> durable;
+  MissionView cancelled;
+  {
+    std::lock_guard lock(mutex_);
+    const DropUnsubmitted drop{staged_};
+    Mission& m = active(id);
+    // Stored first: if that fails, the mission is still active everywhere.
+    if (commits_) commits_->run([&](Store& store) { store.update_mission_state(id, MissionState::cancelled, now_s); });
+    finish(m, MissionState::cancelled, now_s, false);
+    durable = submit_staged();
+    cancelled = view(m);
+  }
+  durable->wait();
+  return cancelled;
 }
 
 PositionResult DispatchService::report_position(const PositionReport& p, double now_s) {
@@ -273,20 +324,19 @@ PositionResult DispatchService::report_position(const PositionReport& p, double 
   }
 
   std::lock_guard lock(mutex_);
+  const DropUnsubmitted drop{staged_};
   PositionResult result;
   result.snap_distance_m = snap.distance_m;
-  std::optional<Store::Transaction> tx;
-  if (store_ != nullptr) tx.emplace(*store_);
   last_position_[p.vehicle_id] = p.position;
   auto it = active_by_vehicle_.find(p.vehicle_id);
   if (it == active_by_vehicle_.end()) {
-    if (store_ != nullptr) store_->insert_position(p, std::nullopt, now_s);
-    if (tx) tx->commit();
+    stage([p, now_s](Store& store) { store.insert_position(p, std::nullopt, now_s); });
+    result.durable = submit_staged();
     return result;
   }
   Mission& m = *missions_.at(it->second);
   result.mission = m.row.id;
-  if (store_ != nullptr) store_->insert_position(p, m.row.id, now_s);
+  stage([p, id = m.row.id, now_s](Store& store) { store.insert_position(p, id, now_s); });
   m.last_position = p.position;
 
   // Signals behind the vehicle: every intersection of the old route before its current edge.
@@ -302,25 +352,27 @@ PositionResult DispatchService::report_position(const PositionReport& p, double 
   const std::vector<EdgeId> old_edges = m.route.edges;
   m.planner->move_start(points);
   m.planner->replan();
+  // This repair also covers any cost change the planner heard of since its last one.
+  const std::string reason = std::exchange(m.unrepaired_change, std::nullopt).value_or("off_route");
   m.route = m.planner->route();
   result.eta_s = m.route.travel_time_s;
   emit("position", m.row.id, p.source, now_s);
   if (!m.route.found || m.route.length_m <= config_.arrival_radius_m ||
       maps::distance_m(snap.point, m.destination_local) <= config_.arrival_radius_m) {
     result.completed = true;
-    finish(m, MissionState::completed, now_s);
+    finish(m, MissionState::completed, now_s, true);
   } else {
     // The route changed if it is not the rest of the old one from the vehicle's edge on.
     const auto from = std::find(old_edges.begin(), old_edges.end(), m.route.edges.front());
     result.route_changed = !std::equal(from, old_edges.end(), m.route.edges.begin(), m.route.edges.end());
     if (result.route_changed) {
-      publish_route(m, "off_route", now_s);
+      publish_route(m, reason, now_s);
     } else {
       preemption_.update_route(m.row.id, m.row.priority, preemption::signalized_crossings(m.route, plans_, now_s), now_s);
       drain_preemption_events();
     }
   }
-  if (tx) tx->commit();
+  result.durable = submit_staged();
   return result;
 }
 
@@ -375,50 +427,79 @@ CongestionResult DispatchService::report_congestion(const std::vector<Congestion
     }
   }
 
-  std::lock_guard lock(mutex_);
-  // A speed or factor update keeps the edge's queue delay; read it under the lock.
-  for (auto& [e, condition] : changes) condition.queue_delay_s = overlay_.edge(e).queue_delay_s;
+  // One congestion change at a time, end to end, so that the database and the planners see the
+  // same order; positions do not wait for it.
+  std::lock_guard serial(congestion_mutex_);
+  {
+    // A speed or factor update keeps the edge's queue delay; read it under the lock.
+    std::lock_guard lock(mutex_);
+    for (auto& [e, condition] : changes) condition.queue_delay_s = overlay_.edge(e).queue_delay_s;
+  }
   // Persist the whole batch before applying any of it, so a storage failure changes nothing.
-  if (store_ != nullptr) {
-    Store::Transaction tx(*store_);
-    for (std::size_t i = 0; i < changes.size(); ++i) store_->insert_congestion(changes[i].first, changes[i].second, expiry[i], now_s);
-    tx.commit();
+  if (commits_) {
+    commits_->run([&](Store& store) {
+      for (std::size_t i = 0; i < changes.size(); ++i) store.insert_congestion(changes[i].first, changes[i].second, expiry[i], now_s);
+    });
   }
+  std::vector<MissionId> affected;
   std::vector<EdgeId> changed;
-  for (std::size_t i = 0; i < changes.size(); ++i) {
-    overlay_.set_edge(changes[i].first, changes[i].second);
-    changed.push_back(changes[i].first);
-    const std::uint64_t seq = ++update_sequence_;
-    latest_update_[changes[i].first] = seq;
-    if (expiry[i]) expiries_.emplace(*expiry[i], std::make_pair(changes[i].first, seq));
+  {
+    std::lock_guard lock(mutex_);
+    for (std::size_t i = 0; i < changes.size(); ++i) {
+      overlay_.set_edge(changes[i].first, changes[i].second);
+      changed.push_back(changes[i].first);
+      const std::uint64_t seq = ++update_sequence_;
+      latest_update_[changes[i].first] = seq;
+      if (expiry[i]) expiries_.emplace(*expiry[i], std::make_pair(changes[i].first, seq));
+    }
+    affected = notify_planners(changed, "congestion");
+    emit("congestion_applied", 0, std::to_string(changed.size()) + " edges", now_s);
   }
-  CongestionResult result = replan_all(changed, "congestion", now_s);
-  emit("congestion_applied", 0, std::to_string(changed.size()) + " edges", now_s);
+  std::vector<std::shared_ptr<CommitTicket>> durable;
+  CongestionResult result = repair_plans(affected, now_s, durable);
+  result.edges_changed = changed.size();
+  for (const auto& t : durable) t->wait();
   return result;
 }
 
-CongestionResult DispatchService::replan_all(const std::vector<EdgeId>& changed, const std::string& reason, double now_s) {
-  CongestionResult result;
-  result.edges_changed = changed.size();
-  // Every planner hears of every change before any replan can fail on storage: D* Lite must be
-  // told of each change exactly once.
-  for (auto& [id, m] : missions_) {
-    if (m->row.state == MissionState::active) m->planner->edges_changed(changed);
-  }
+std::vector<MissionId> DispatchService::notify_planners(const std::vector<EdgeId>& changed, const std::string& reason) {
+  // D* Lite must hear of each change exactly once, before its next repair.
+  std::vector<MissionId> affected;
   for (auto& [id, m] : missions_) {
     if (m->row.state != MissionState::active) continue;
-    const std::vector<EdgeId> before = m->route.edges;
-    m->planner->replan();
-    m->route = m->planner->route();
+    m->planner->edges_changed(changed);
+    m->unrepaired_change = reason;
+    affected.push_back(id);
+  }
+  return affected;
+}
+
+CongestionResult DispatchService::repair_plans(const std::vector<MissionId>& missions, double now_s,
+                                               std::vector<std::shared_ptr<CommitTicket>>& durable) {
+  CongestionResult result;
+  // One mission per lock: position reports for other missions go between them, so a large
+  // congestion batch does not stall the whole fleet.
+  for (MissionId id : missions) {
+    std::lock_guard lock(mutex_);
+    const DropUnsubmitted drop{staged_};
+    auto it = missions_.find(id);
+    if (it == missions_.end() || it->second->row.state != MissionState::active) continue;
+    Mission& m = *it->second;
     ++result.missions_replanned;
-    if (m->route.edges != before) {
+    if (!m.unrepaired_change) continue;  // a position report repaired it in the meantime
+    const std::string reason = *std::exchange(m.unrepaired_change, std::nullopt);
+    const std::vector<EdgeId> before = m.route.edges;
+    m.planner->replan();
+    m.route = m.planner->route();
+    if (m.route.edges != before) {
       ++result.routes_changed;
-      publish_route(*m, reason, now_s);
+      publish_route(m, reason, now_s);
     } else {
       // Same route, new costs: the arrival times moved, so the signals are re-timed.
-      preemption_.update_route(id, m->row.priority, preemption::signalized_crossings(m->route, plans_, now_s), now_s);
+      preemption_.update_route(id, m.row.priority, preemption::signalized_crossings(m.route, plans_, now_s), now_s);
       drain_preemption_events();
     }
+    durable.push_back(submit_staged());
   }
   return result;
 }
@@ -434,21 +515,31 @@ void DispatchService::report_counts(NodeId node, maps::Compass approach, double 
 }
 
 void DispatchService::tick(double now_s) {
-  std::lock_guard lock(mutex_);
-  std::vector<EdgeId> expired;
-  while (!expiries_.empty() && expiries_.begin()->first <= now_s) {
-    const auto [e, seq] = expiries_.begin()->second;
-    expiries_.erase(expiries_.begin());
-    // An expiry ends only the update it came with; a later update of the edge stays in force.
-    if (latest_update_[e] != seq) continue;
-    latest_update_.erase(e);
-    overlay_.reset_edge(e);
-    expired.push_back(e);
+  std::lock_guard serial(congestion_mutex_);
+  std::vector<MissionId> affected;
+  {
+    std::lock_guard lock(mutex_);
+    std::vector<EdgeId> expired;
+    while (!expiries_.empty() && expiries_.begin()->first <= now_s) {
+      const auto [e, seq] = expiries_.begin()->second;
+      expiries_.erase(expiries_.begin());
+      // An expiry ends only the update it came with; a later update of the edge stays in force.
+      if (latest_update_[e] != seq) continue;
+      latest_update_.erase(e);
+      overlay_.reset_edge(e);
+      expired.push_back(e);
+    }
+    if (!expired.empty()) affected = notify_planners(expired, "congestion_expired");
   }
-  if (!expired.empty()) replan_all(expired, "congestion_expired", now_s);
+  // Nobody waits for the tick's writes; a failure is logged by the queue.
+  std::vector<std::shared_ptr<CommitTicket>> durable;
+  repair_plans(affected, now_s, durable);
+  std::lock_guard lock(mutex_);
+  const DropUnsubmitted drop{staged_};
   signals_.advance(now_s);
   preemption_.tick(now_s);
   drain_preemption_events();
+  submit_staged();
 }
 
 std::vector<preemption::Light> DispatchService::signal_lights(NodeId node) const {
@@ -513,6 +604,7 @@ void DispatchService::restore(double now_s) {
       spdlog::error("event=mission_not_resumable mission={} reason=\"{}\"", row.id, e.what());
     }
   }
+  submit_staged()->wait();
 }
 
 }  // namespace corridor::server

@@ -1,7 +1,8 @@
 // The dispatch service: the server's engine behind one facade. It owns the live congestion overlay,
 // one D* Lite planner per active mission, and the preemption engine; it persists every accepted
-// change before returning and rebuilds its state from the store on start-up. Transport-free, so
-// request handling can be tested and fuzzed without sockets.
+// change before acknowledging it and rebuilds its state from the store on start-up. Writes go
+// through a group-commit queue; a position's result carries the ticket that says when it is
+// durable. Transport-free, so request handling can be tested and fuzzed without sockets.
 #pragma once
 
 #include <functional>
@@ -16,6 +17,7 @@
 #include "preemption/engine.hpp"
 #include "preemption/simulated_signal_controller.hpp"
 #include "server/api_error.hpp"
+#include "server/commit_queue.hpp"
 #include "server/dispatch_types.hpp"
 #include "server/store.hpp"
 
@@ -40,16 +42,21 @@ class DispatchService {
                   Store* store, double now_s);
   ~DispatchService();
 
-  // Every method validates its input and throws ApiError with a status and a clear message.
+  // Every method validates its input and throws ApiError with a status and a clear message. Every
+  // method but report_position returns once its writes are durable (StoreError if they failed).
   MissionView create_mission(const MissionRequest& request, double now_s);
   [[nodiscard]] MissionView mission(MissionId id) const;
   [[nodiscard]] std::vector<MissionView> missions(std::optional<MissionState> state) const;
   MissionView cancel_mission(MissionId id, double now_s);
+  // Returns before its writes are durable: acknowledge only once `result.durable` says so.
   PositionResult report_position(const PositionReport& report, double now_s);
   CongestionResult report_congestion(const std::vector<CongestionUpdate>& updates, double now_s);
   void report_counts(NodeId node, maps::Compass approach, double arrivals, double departures, double now_s);
   // Expires congestion and drives the signals; call about once a second.
   void tick(double now_s);
+  // Waits until every write so far is durable.
+  void flush();
+  [[nodiscard]] std::optional<CommitQueue::Stats> commit_stats() const;
 
   // Returns an id for unsubscribe(); a listener must be removed before it is destroyed.
   std::size_t subscribe(Listener listener);
@@ -68,26 +75,36 @@ class DispatchService {
   Mission& active(MissionId id);
   enum class Role { start, goal };
   std::vector<planner::EdgePoint> endpoints(const maps::SnapResult& snap, Role role, std::optional<double> heading_deg) const;
-  // A new route revision: persist_route writes it (may throw StoreError, before anything is
-  // shared); announce_route re-times the signals and tells the listeners.
+  // A new route revision: persist_route stages its write; announce_route re-times the signals
+  // and tells the listeners.
   void persist_route(Mission& m, const std::string& reason, double now_s);
   void announce_route(Mission& m, const std::string& reason, double now_s);
   void publish_route(Mission& m, const std::string& reason, double now_s) {
     persist_route(m, reason, now_s);
     announce_route(m, reason, now_s);
   }
-  // Repairs every active mission's plan after `changed` edges changed cost; publishes new routes.
-  CongestionResult replan_all(const std::vector<EdgeId>& changed, const std::string& reason, double now_s);
+  // Tells every active mission's planner that `changed` edges changed cost (under the lock);
+  // returns the missions to repair.
+  std::vector<MissionId> notify_planners(const std::vector<EdgeId>& changed, const std::string& reason);
+  // Repairs those plans one mission per lock and publishes new routes; collects the write tickets.
+  CongestionResult repair_plans(const std::vector<MissionId>& missions, double now_s,
+                                std::vector<std::shared_ptr<CommitTicket>>& durable);
   void drain_preemption_events();
   void emit(const std::string& kind, MissionId mission, const std::string& reason, double now_s);
   MissionView view(const Mission& m) const;
-  void finish(Mission& m, MissionState state, double now_s);
+  // `stage_state` false: the caller has already stored the new state.
+  void finish(Mission& m, MissionState state, double now_s, bool stage_state);
+  // Writes staged under the lock go to the commit queue together, in order, as one ticket.
+  void stage(CommitQueue::Write write);
+  std::shared_ptr<CommitTicket> submit_staged();
   std::vector<EdgeId> resolve_edges(const CongestionUpdate& u) const;
   void restore(double now_s);
 
   const maps::RoadGraph& graph_;
   DispatchConfig config_;
   Store* store_;
+  std::unique_ptr<CommitQueue> commits_;    // null without a store
+  std::vector<CommitQueue::Write> staged_;  // this call's writes, not yet submitted
   maps::EdgeSnapper snapper_;
   planner::CostOverlay overlay_;
   std::unordered_map<NodeId, maps::SignalPlan> plans_;
@@ -106,6 +123,8 @@ class DispatchService {
   std::size_t next_listener_ = 1;
   MissionId next_memory_id_ = 1;
   mutable std::mutex mutex_;
+  // Serializes congestion changes and expiries end to end (taken before mutex_, never after).
+  std::mutex congestion_mutex_;
 };
 
 }  // namespace corridor::server

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -11,6 +12,8 @@
 #include "preemption/engine.hpp"
 
 namespace corridor::server {
+
+class CommitTicket;  // server/commit_queue.hpp
 
 using MissionId = std::uint64_t;
 
@@ -66,6 +69,7 @@ struct PositionResult {
   bool route_changed = false;
   bool completed = false;
   double eta_s = 0;
+  std::shared_ptr<CommitTicket> durable;  // when the report and its consequences are stored
 };
 
 struct CongestionResult {

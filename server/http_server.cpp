@@ -34,6 +34,11 @@ class EventHub {
     sessions_.push_back(s);
   }
   void publish(const std::string& text, MissionId mission);
+  // Lets the publisher skip rendering an event that nobody would receive.
+  [[nodiscard]] bool empty() {
+    std::lock_guard lock(mutex_);
+    return sessions_.empty();
+  }
 
  private:
   std::mutex mutex_;
@@ -156,9 +161,15 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
       std::make_shared<WsSession>(stream_.release_socket(), hub_, filter, limits_.max_queued_events)->run(std::move(req));
       return;
     }
-    const HttpResponse r = router_.handle({std::string(req.method_string()), target,
-                                           std::string(req[http::field::authorization]), std::move(req.body())});
-    respond(r.status, r.content_type, r.body, req.keep_alive());
+    // The answer may come from the commit thread once the request's writes are durable; it is
+    // written from this connection's strand.
+    router_.handle_async({std::string(req.method_string()), target, std::string(req[http::field::authorization]),
+                          std::move(req.body())},
+                         [self = shared_from_this(), keep_alive = req.keep_alive()](HttpResponse r) {
+                           net::dispatch(self->stream_.get_executor(), [self, keep_alive, r = std::move(r)]() mutable {
+                             self->respond(r.status, r.content_type, std::move(r.body), keep_alive);
+                           });
+                         });
   }
 
   void reply_error(int status, const std::string& code, const std::string& message, bool keep_alive) {
@@ -254,7 +265,9 @@ HttpServer::HttpServer(Router& router, DispatchService& service, ServerLimits li
   impl_->acceptor.bind(endpoint);
   impl_->acceptor.listen(net::socket_base::max_listen_connections);
   impl_->subscription =
-      service.subscribe([hub = &impl_->hub](const DispatchEvent& e) { hub->publish(event_to_json(e).dump(), e.mission); });
+      service.subscribe([hub = &impl_->hub](const DispatchEvent& e) {
+        if (!hub->empty()) hub->publish(event_to_json(e).dump(), e.mission);
+      });
 }
 
 HttpServer::~HttpServer() {

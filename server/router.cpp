@@ -76,13 +76,13 @@ Router::Router(DispatchService& service, TokenAuth auth, RouterConfig config, Cl
   });
   add("GET", "/metrics", 0, "Prometheus metrics", [this](const Principal&, const Match&, const HttpRequest&) {
     metrics_.set_gauge("active_missions", static_cast<double>(service_.active_mission_count()));
-    return HttpResponse{200, "text/plain; version=0.0.4", metrics_.render()};
+    return HttpResponse{200, "text/plain; version=0.0.4", metrics_.render(), nullptr};
   });
   add("GET", "/v1/openapi.json", 0, "This API description", [this](const Principal&, const Match&, const HttpRequest&) {
     return json_response(200, openapi());
   });
   add("GET", "/v1/map", kRead, "The road graph as GeoJSON", [this](const Principal&, const Match&, const HttpRequest&) {
-    return HttpResponse{200, "application/geo+json", map_geojson_};
+    return HttpResponse{200, "application/geo+json", map_geojson_, nullptr};
   });
   add("POST", "/v1/missions", kDispatch, "Create a mission", [this](const Principal&, const Match&, const HttpRequest& r) {
     const auto started = std::chrono::steady_clock::now();
@@ -123,7 +123,9 @@ Router::Router(DispatchService& service, TokenAuth auth, RouterConfig config, Cl
                  {"completed", res.completed}};
         out["mission"] = res.mission ? json(*res.mission) : json(nullptr);
         out["eta_s"] = res.mission && !res.completed ? json(res.eta_s) : json(nullptr);
-        return json_response(200, out);
+        HttpResponse response = json_response(200, out);
+        response.after_commit = res.durable;
+        return response;
       });
   add("POST", "/v1/congestion", kSensor, "Report congestion on edges or OSM ways",
       [this](const Principal&, const Match&, const HttpRequest& r) {
@@ -183,7 +185,7 @@ void Router::add(std::string method, std::string pattern, std::uint8_t roles, st
 }
 
 HttpResponse Router::json_response(int status, const json& body) const {
-  return {status, "application/json", body.dump(-1, ' ', false, json::error_handler_t::replace)};
+  return {status, "application/json", body.dump(-1, ' ', false, json::error_handler_t::replace), nullptr};
 }
 
 bool Router::take_token(const std::string& key, double now_s) {
@@ -205,9 +207,49 @@ std::optional<Principal> Router::authorize_stream(const std::string& authorizati
   return who;
 }
 
+HttpResponse Router::storage_failure(const std::string& route_name, const std::string& error) const {
+  spdlog::error("event=store_failure route=\"{}\" error=\"{}\"", route_name, error);
+  return json_response(503, error_json("storage_unavailable", "the change could not be stored; it was not acknowledged"));
+}
+
 HttpResponse Router::handle(const HttpRequest& request) noexcept {
   const auto started = std::chrono::steady_clock::now();
   std::string route_name = "unmatched";
+  HttpResponse response = answer(request, route_name);
+  if (response.after_commit) {
+    try {
+      response.after_commit->wait();
+      response.after_commit.reset();
+    } catch (const std::exception& e) {
+      response = storage_failure(route_name, e.what());
+    }
+  }
+  metrics_.observe_request(route_name, response.status,
+                           std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+  return response;
+}
+
+void Router::handle_async(const HttpRequest& request, std::function<void(HttpResponse)> reply) noexcept {
+  const auto started = std::chrono::steady_clock::now();
+  std::string route_name = "unmatched";
+  HttpResponse response = answer(request, route_name);
+  auto finish = [this, started, route_name, reply = std::move(reply)](HttpResponse r) {
+    metrics_.observe_request(route_name, r.status,
+                             std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+    try {
+      reply(std::move(r));
+    } catch (const std::exception& e) {
+      spdlog::error("event=reply_failed route=\"{}\" error=\"{}\"", route_name, e.what());
+    }
+  };
+  if (!response.after_commit) return finish(std::move(response));
+  const auto ticket = std::exchange(response.after_commit, nullptr);
+  ticket->on_done([this, route_name, response = std::move(response), finish = std::move(finish)](const std::string* error) mutable {
+    finish(error != nullptr ? storage_failure(route_name, *error) : std::move(response));
+  });
+}
+
+HttpResponse Router::answer(const HttpRequest& request, std::string& route_name) noexcept {
   HttpResponse response;
   try {
     const auto q = request.target.find('?');
@@ -267,16 +309,13 @@ HttpResponse Router::handle(const HttpRequest& request) noexcept {
   } catch (const nlohmann::json::exception& e) {
     response = json_response(400, error_json("bad_request", std::string("invalid JSON value: ") + e.what()));
   } catch (const StoreError& e) {
-    spdlog::error("event=store_failure route=\"{}\" error=\"{}\"", route_name, e.what());
-    response = json_response(503, error_json("storage_unavailable", "the change could not be stored; it was not applied"));
+    response = storage_failure(route_name, e.what());
   } catch (const std::exception& e) {
     spdlog::error("event=internal_error route=\"{}\" error=\"{}\"", route_name, e.what());
     response = json_response(500, error_json("internal", "internal error; the request was not applied"));
   } catch (...) {
     response = json_response(500, error_json("internal", "internal error; the request was not applied"));
   }
-  metrics_.observe_request(route_name, response.status,
-                           std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
   return response;
 }
 

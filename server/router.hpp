@@ -4,6 +4,7 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -29,6 +30,9 @@ struct HttpResponse {
   int status = 200;
   std::string content_type = "application/json";
   std::string body;
+  // Set while the request's writes are still on their way to the database: the response may be
+  // sent only once this ticket is durable (and becomes a 503 if it fails).
+  std::shared_ptr<CommitTicket> after_commit;
 };
 
 struct RouterConfig {
@@ -45,7 +49,11 @@ class Router {
   Router(const Router&) = delete;
   Router& operator=(const Router&) = delete;
 
+  // Answers once the request's writes are durable; blocks until then.
   HttpResponse handle(const HttpRequest& request) noexcept;
+  // Same answer, delivered through `reply` once durable: at once on the caller's thread, or later
+  // on the commit thread. Never throws.
+  void handle_async(const HttpRequest& request, std::function<void(HttpResponse)> reply) noexcept;
   // For the WebSocket upgrade: the principal if it may read the stream.
   [[nodiscard]] std::optional<Principal> authorize_stream(const std::string& authorization) const;
   [[nodiscard]] nlohmann::json openapi() const;
@@ -69,6 +77,9 @@ class Router {
   void add(std::string method, std::string pattern, std::uint8_t roles, std::string summary, Handler handler);
   bool take_token(const std::string& key, double now_s);
   HttpResponse json_response(int status, const nlohmann::json& body) const;
+  // The answer, possibly still waiting on after_commit; records nothing in the metrics.
+  HttpResponse answer(const HttpRequest& request, std::string& route_name) noexcept;
+  HttpResponse storage_failure(const std::string& route_name, const std::string& error) const;
 
   DispatchService& service_;
   TokenAuth auth_;

@@ -1,9 +1,18 @@
 #include "server/store.hpp"
 
+#include <fcntl.h>
+#include <spdlog/spdlog.h>
 #include <sqlite3.h>
+#include <sys/file.h>
+#include <unistd.h>
 
 #include <array>
+#include <cerrno>
 #include <cmath>
+#include <condition_variable>
+#include <cstring>
+#include <mutex>
+#include <thread>
 
 namespace corridor::server {
 namespace {
@@ -61,12 +70,21 @@ constexpr std::array<const char*, 1> kMigrations{
 
 class Statement {
  public:
-  Statement(sqlite3* db, const char* sql) {
+  Statement(sqlite3* db, const char* sql) : owned_(true) {
     if (sqlite3_prepare_v2(db, sql, -1, &stmt_, nullptr) != SQLITE_OK) {
       throw StoreError(std::string("cannot prepare statement: ") + sqlite3_errmsg(db));
     }
   }
-  ~Statement() { sqlite3_finalize(stmt_); }
+  // Borrows a prepared statement from the store's cache and resets it for the next user.
+  explicit Statement(sqlite3_stmt* cached) : stmt_(cached), owned_(false) {}
+  ~Statement() {
+    if (owned_) {
+      sqlite3_finalize(stmt_);
+    } else {
+      sqlite3_reset(stmt_);
+      sqlite3_clear_bindings(stmt_);
+    }
+  }
   Statement(const Statement&) = delete;
   Statement& operator=(const Statement&) = delete;
 
@@ -102,34 +120,137 @@ class Statement {
     return *this;
   }
   sqlite3_stmt* stmt_ = nullptr;
+  bool owned_;
 };
 
 }  // namespace
 
+// Copies the WAL back into the database file on its own connection and thread, so that no commit
+// waits for a checkpoint's fsync. PASSIVE checkpoints never block the writer, but under sustained
+// load the writer never finds the WAL fully copied, so SQLite never rewinds it; past the hard limit
+// a RESTART checkpoint (a short stall of the writer, after PASSIVE copied the bulk) rewinds it.
+class Store::Checkpointer {
+ public:
+  static constexpr int kCheckpointFrames = 1000;  // SQLite's own auto-checkpoint threshold
+  static constexpr int kHardLimitFrames = 4000;  // about 16 MB of WAL
+
+  explicit Checkpointer(const std::filesystem::path& file) {
+    if (sqlite3_open_v2(file.c_str(), &db_, SQLITE_OPEN_READWRITE, nullptr) != SQLITE_OK) {
+      const std::string why = db_ != nullptr ? sqlite3_errmsg(db_) : "out of memory";
+      sqlite3_close(db_);
+      throw StoreError("cannot open database '" + file.string() + "' for checkpoints: " + why);
+    }
+    sqlite3_busy_timeout(db_, 5000);
+    // A connection opens the WAL only once it reads the database; until then a checkpoint is a no-op.
+    if (sqlite3_exec(db_, "PRAGMA journal_mode=WAL", nullptr, nullptr, nullptr) != SQLITE_OK) {
+      const std::string why = sqlite3_errmsg(db_);
+      sqlite3_close(db_);
+      throw StoreError("cannot open database '" + file.string() + "' for checkpoints: " + why);
+    }
+    thread_ = std::thread([this] { loop(); });
+  }
+  ~Checkpointer() {
+    {
+      std::lock_guard lock(mutex_);
+      stopping_ = true;
+    }
+    cv_.notify_one();
+    thread_.join();
+    sqlite3_close(db_);
+  }
+  Checkpointer(const Checkpointer&) = delete;
+  Checkpointer& operator=(const Checkpointer&) = delete;
+
+  // Called by SQLite on the writer's thread after each commit.
+  static int on_commit(void* self, sqlite3*, const char*, int wal_frames) {
+    if (wal_frames >= kCheckpointFrames) static_cast<Checkpointer*>(self)->request();
+    return SQLITE_OK;
+  }
+
+ private:
+  void request() {
+    {
+      std::lock_guard lock(mutex_);
+      wanted_ = true;
+    }
+    cv_.notify_one();
+  }
+  void loop() {
+    std::unique_lock lock(mutex_);
+    for (;;) {
+      cv_.wait(lock, [&] { return stopping_ || wanted_; });
+      if (stopping_) return;
+      wanted_ = false;
+      lock.unlock();
+      int wal_frames = 0;
+      int copied = 0;
+      int rc = sqlite3_wal_checkpoint_v2(db_, nullptr, SQLITE_CHECKPOINT_PASSIVE, &wal_frames, &copied);
+      if (rc == SQLITE_OK && wal_frames > kHardLimitFrames) {
+        spdlog::debug("event=wal_restart_checkpoint wal_frames={}", wal_frames);
+        rc = sqlite3_wal_checkpoint_v2(db_, nullptr, SQLITE_CHECKPOINT_RESTART, &wal_frames, &copied);
+      }
+      if (rc != SQLITE_OK && rc != SQLITE_BUSY) spdlog::warn("event=checkpoint_failed error=\"{}\"", sqlite3_errmsg(db_));
+      lock.lock();
+    }
+  }
+
+  sqlite3* db_ = nullptr;
+  std::thread thread_;
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  bool wanted_ = false;
+  bool stopping_ = false;
+};
+
 Store::Store(const std::filesystem::path& file, Durability durability) : file_(file) {
+  // One server owns its database. An advisory lock beside it keeps a second server out; the
+  // kernel drops it when the process dies, kill -9 included.
+  const std::string lock_path = file.string() + ".lock";
+  lock_fd_ = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (lock_fd_ < 0) throw StoreError("cannot create lock file '" + lock_path + "': " + std::strerror(errno));
+  if (::flock(lock_fd_, LOCK_EX | LOCK_NB) != 0) {
+    ::close(lock_fd_);
+    throw StoreError("database '" + file.string() + "' is in use by another corridor server (it holds '" + lock_path + "')");
+  }
   if (sqlite3_open_v2(file.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX, nullptr) !=
       SQLITE_OK) {
     const std::string why = db_ != nullptr ? sqlite3_errmsg(db_) : "out of memory";
     sqlite3_close(db_);
+    ::close(lock_fd_);
     throw StoreError("cannot open database '" + file.string() + "': " + why);
   }
   sqlite3_busy_timeout(db_, 5000);
   try {
-    // One server owns its database: exclusive locking drops the per-transaction fcntl locks and
-    // keeps a second server from opening the same file.
-    exec("PRAGMA locking_mode=EXCLUSIVE");
     exec("PRAGMA journal_mode=WAL");
     exec(durability == Durability::power_loss ? "PRAGMA synchronous=FULL" : "PRAGMA synchronous=NORMAL");
     exec("PRAGMA foreign_keys=ON");
     exec("CREATE TABLE IF NOT EXISTS schema_migrations (version INTEGER PRIMARY KEY, applied_s REAL NOT NULL)");
     migrate();
+    // Checkpoints move off the commit path (the hook replaces SQLite's auto-checkpoint).
+    checkpointer_ = std::make_unique<Checkpointer>(file);
+    sqlite3_wal_hook(db_, &Checkpointer::on_commit, checkpointer_.get());
   } catch (...) {
     sqlite3_close(db_);
+    ::close(lock_fd_);
     throw;
   }
 }
 
-Store::~Store() { sqlite3_close(db_); }
+Store::~Store() {
+  sqlite3_wal_hook(db_, nullptr, nullptr);
+  checkpointer_.reset();
+  for (auto& [sql, stmt] : statements_) sqlite3_finalize(stmt);
+  sqlite3_close(db_);  // the last connection checkpoints and removes the WAL
+  ::close(lock_fd_);   // releases the lock
+}
+
+sqlite3_stmt* Store::cached(const char* sql) {
+  auto& stmt = statements_[sql];
+  if (stmt == nullptr && sqlite3_prepare_v3(db_, sql, -1, SQLITE_PREPARE_PERSISTENT, &stmt, nullptr) != SQLITE_OK) {
+    throw StoreError(std::string("cannot prepare statement: ") + sqlite3_errmsg(db_));
+  }
+  return stmt;
+}
 
 void Store::exec(const std::string& sql) const {
   char* err = nullptr;
@@ -176,9 +297,8 @@ void Store::Transaction::commit() {
 }
 
 MissionId Store::insert_mission(const MissionRow& r) {
-  Statement s(db_,
-              "INSERT INTO missions(vehicle_id, priority, vmax_kmh, dest_lat, dest_lon, origin_lat, origin_lon, state, "
-              "created_s, updated_s) VALUES (?,?,?,?,?,?,?,?,?,?)");
+  Statement s(cached("INSERT INTO missions(vehicle_id, priority, vmax_kmh, dest_lat, dest_lon, origin_lat, origin_lon, state, "
+                     "created_s, updated_s) VALUES (?,?,?,?,?,?,?,?,?,?)"));
   s.bind(1, r.vehicle_id).bind(2, static_cast<std::int64_t>(r.priority)).bind(3, r.vmax_kmh);
   s.bind(4, r.destination.lat_deg).bind(5, r.destination.lon_deg);
   s.bind(6, r.origin ? std::optional<double>(r.origin->lat_deg) : std::nullopt);
@@ -189,14 +309,13 @@ MissionId Store::insert_mission(const MissionRow& r) {
 }
 
 void Store::update_mission_state(MissionId id, MissionState state, double time_s) {
-  Statement s(db_, "UPDATE missions SET state = ?, updated_s = ? WHERE id = ?");
+  Statement s(cached("UPDATE missions SET state = ?, updated_s = ? WHERE id = ?"));
   s.bind(1, std::string(to_string(state))).bind(2, time_s).bind(3, static_cast<std::int64_t>(id)).step();
 }
 
 void Store::insert_position(const PositionReport& p, std::optional<MissionId> mission, double received_s) {
-  Statement s(db_,
-              "INSERT INTO positions(vehicle_id, mission_id, lat, lon, heading_deg, speed_mps, hdop, timestamp_s, "
-              "source, received_s) VALUES (?,?,?,?,?,?,?,?,?,?)");
+  Statement s(cached("INSERT INTO positions(vehicle_id, mission_id, lat, lon, heading_deg, speed_mps, hdop, timestamp_s, "
+                     "source, received_s) VALUES (?,?,?,?,?,?,?,?,?,?)"));
   s.bind(1, p.vehicle_id);
   s.bind(2, mission ? std::optional<double>(static_cast<double>(*mission)) : std::nullopt);
   s.bind(3, p.position.lat_deg).bind(4, p.position.lon_deg).bind(5, p.heading_deg).bind(6, p.speed_mps).bind(7, p.hdop);
@@ -205,24 +324,22 @@ void Store::insert_position(const PositionReport& p, std::optional<MissionId> mi
 
 void Store::insert_route_revision(MissionId mission, std::uint32_t revision, const std::string& reason, double eta_s,
                                   double length_m, const std::string& geometry_json, double time_s) {
-  Statement s(db_,
-              "INSERT OR REPLACE INTO route_revisions(mission_id, revision, reason, eta_s, length_m, geometry, "
-              "created_s) VALUES (?,?,?,?,?,?,?)");
+  Statement s(cached("INSERT OR REPLACE INTO route_revisions(mission_id, revision, reason, eta_s, length_m, geometry, "
+                     "created_s) VALUES (?,?,?,?,?,?,?)"));
   s.bind(1, static_cast<std::int64_t>(mission)).bind(2, static_cast<std::int64_t>(revision)).bind(3, reason);
   s.bind(4, eta_s).bind(5, length_m).bind(6, geometry_json).bind(7, time_s).step();
 }
 
 void Store::insert_congestion(EdgeId edge, const planner::EdgeCondition& c, std::optional<double> expires_at_s,
                               double time_s) {
-  Statement s(db_,
-              "INSERT INTO congestion(edge, factor, queue_delay_s, expires_at_s, created_s) VALUES (?,?,?,?,?)");
+  Statement s(cached("INSERT INTO congestion(edge, factor, queue_delay_s, expires_at_s, created_s) VALUES (?,?,?,?,?)"));
   // NULL factor stands for a closure (infinity is not a SQL value).
   s.bind(1, static_cast<std::int64_t>(edge.v)).bind(2, std::optional<double>(c.congestion_factor));
   s.bind(3, c.queue_delay_s).bind(4, expires_at_s).bind(5, time_s).step();
 }
 
 void Store::insert_preemption_event(const preemption::PreemptionEvent& e) {
-  Statement s(db_, "INSERT INTO preemption_events(mission_id, node, kind, detail, time_s) VALUES (?,?,?,?,?)");
+  Statement s(cached("INSERT INTO preemption_events(mission_id, node, kind, detail, time_s) VALUES (?,?,?,?,?)"));
   s.bind(1, static_cast<std::int64_t>(e.mission)).bind(2, static_cast<std::int64_t>(e.node.v)).bind(3, e.kind);
   s.bind(4, e.detail).bind(5, e.time_s).step();
 }

@@ -1,13 +1,16 @@
 // SQLite persistence (WAL) of everything the dispatch service acknowledges: missions, positions,
 // route revisions, congestion updates and preemption events, with versioned migrations. Writes
-// complete before the caller acknowledges; restart recovery reads them back.
+// complete before the caller acknowledges; restart recovery reads them back. WAL checkpoints run
+// on a background connection, off the commit path.
 #pragma once
 
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "maps/ids.hpp"
@@ -56,7 +59,8 @@ enum class Durability {
 
 class Store {
  public:
-  // Opens or creates the database and applies pending migrations. Throws StoreError.
+  // Opens or creates the database and applies pending migrations. Throws StoreError, also when
+  // another server has the database open.
   explicit Store(const std::filesystem::path& file, Durability durability = Durability::process_crash);
   ~Store();
   Store(const Store&) = delete;
@@ -96,8 +100,15 @@ class Store {
  private:
   void exec(const std::string& sql) const;
   void migrate();
+  // Write statements are prepared once; writes come from one thread at a time (the commit queue).
+  sqlite3_stmt* cached(const char* sql);
+
+  class Checkpointer;
 
   sqlite3* db_ = nullptr;
+  int lock_fd_ = -1;
+  std::unique_ptr<Checkpointer> checkpointer_;
+  std::unordered_map<const char*, sqlite3_stmt*> statements_;  // keyed by the SQL literal's address
   std::filesystem::path file_;
 };
 

@@ -8,6 +8,7 @@
 
 #include "maps/synthetic_grid.hpp"
 #include "planner/one_to_one_search.hpp"
+#include "tests/server/temp_db.hpp"
 
 namespace corridor::server {
 namespace {
@@ -30,20 +31,6 @@ const maps::RoadGraph& grid() {
 
 maps::LatLon node_ll(NodeId n) { return grid().projection().to_lat_lon(grid().position(n)); }
 maps::LatLon corner(bool far) { return node_ll(NodeId{far ? static_cast<std::uint32_t>(grid().node_count() - 1) : 0u}); }
-
-class TempDb {
- public:
-  TempDb() : path_(std::filesystem::temp_directory_path() / ("corridor-db-" + std::to_string(::getpid()) + "-" +
-                                                             std::to_string(counter_++) + ".db")) {}
-  ~TempDb() {
-    for (const char* suffix : {"", "-wal", "-shm"}) std::filesystem::remove(path_.string() + suffix);
-  }
-  [[nodiscard]] const std::filesystem::path& path() const { return path_; }
-
- private:
-  static inline int counter_ = 0;
-  std::filesystem::path path_;
-};
 
 MissionRequest request(const std::string& vehicle) {
   MissionRequest r;

@@ -1,10 +1,13 @@
 #include "server/router.hpp"
 
 #include <gtest/gtest.h>
+#include <sqlite3.h>
 
+#include <future>
 #include <random>
 
 #include "maps/synthetic_grid.hpp"
+#include "tests/server/temp_db.hpp"
 
 namespace corridor::server {
 namespace {
@@ -157,6 +160,36 @@ TEST(Router, SignalsMapHealthAndMetrics) {
 
 // Per-token token bucket: a burst is allowed, then 429 until time refills it; other tokens are
 // not affected.
+TEST(Router, APositionIsAnsweredOnlyOnceStoredAndA503WhenItCannotBe) {
+  TempDb db;
+  Store store(db.path());
+  DispatchService service(grid(), {}, &store, 0.0);
+  Router router(service, Rig::make_auth(), {}, [] { return 100.0; });
+  const std::string pos = R"({"lat":)" + std::to_string(grid().projection().to_lat_lon(grid().position(NodeId{0})).lat_deg) +
+                          R"(,"lon":)" + std::to_string(grid().projection().to_lat_lon(grid().position(NodeId{0})).lon_deg) +
+                          R"(,"timestamp":1,"source":"gps"})";
+  auto post = [&] {
+    std::promise<std::pair<int, std::size_t>> answered;
+    router.handle_async({"POST", "/v1/vehicles/amb-1/position", kAmb1, pos}, [&](HttpResponse r) {
+      // What the client is told must already be in the database.
+      answered.set_value({r.status, r.status == 200 ? store.count("positions") : 0});
+    });
+    return answered.get_future().get();
+  };
+  EXPECT_EQ(post(), std::make_pair(200, std::size_t{1}));
+  EXPECT_EQ(post(), std::make_pair(200, std::size_t{2}));
+
+  // The positions table disappears under the server: the write fails, so the answer is a 503.
+  sqlite3* raw = nullptr;
+  ASSERT_EQ(sqlite3_open(db.path().c_str(), &raw), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(raw, "DROP TABLE positions", nullptr, nullptr, nullptr), SQLITE_OK);
+  sqlite3_close(raw);
+  EXPECT_EQ(post().first, 503);
+  const HttpResponse sync = router.handle({"POST", "/v1/vehicles/amb-1/position", kAmb1, pos});
+  EXPECT_EQ(sync.status, 503);
+  EXPECT_NE(sync.body.find("storage_unavailable"), std::string::npos);
+}
+
 TEST(Router, RateLimitPerToken) {
   DispatchService service(grid(), {}, nullptr, 0.0);
   double now = 0.0;

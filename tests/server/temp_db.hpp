@@ -1,0 +1,28 @@
+// A database path in the temp directory, unique per process and test, removed with its WAL,
+// shared-memory and lock files.
+#pragma once
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <string>
+
+namespace corridor::server {
+
+class TempDb {
+ public:
+  TempDb() : path_(std::filesystem::temp_directory_path() / ("corridor-db-" + std::to_string(::getpid()) + "-" +
+                                                             std::to_string(counter_++) + ".db")) {}
+  ~TempDb() {
+    for (const char* suffix : {"", "-wal", "-shm", ".lock"}) std::filesystem::remove(path_.string() + suffix);
+  }
+  TempDb(const TempDb&) = delete;
+  TempDb& operator=(const TempDb&) = delete;
+  [[nodiscard]] const std::filesystem::path& path() const { return path_; }
+
+ private:
+  static inline int counter_ = 0;
+  std::filesystem::path path_;
+};
+
+}  // namespace corridor::server
