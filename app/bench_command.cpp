@@ -73,6 +73,8 @@ void register_bench_command(CLI::App& app) {
   serve->add_option("--congestion-edges-per-s", s->second.congestion_edges_per_s, "congested edges per second")
       ->capture_default_str();
   serve->add_option("--seconds", s->second.seconds, "duration of the load")->capture_default_str();
+  serve->add_option("--rate", s->second.rate_per_s, "position reports per second, paced (0 = back to back)")
+      ->capture_default_str();
   serve->add_option("--client-threads", s->second.client_threads, "load generator threads")->capture_default_str();
   serve->add_option("--server-threads", s->second.server_threads, "server I/O threads")->capture_default_str();
   serve->callback([s] {

@@ -1,6 +1,6 @@
 // `corridor bench serve`: load on the real HTTP server over loopback. Vehicles post positions along
-// their mission routes as fast as the clients allow, while a sensor posts congestion at a fixed
-// edge rate. Reports throughput and client-side latency percentiles as JSON.
+// their mission routes, each on its own connection, back to back or at a fixed total rate, while a
+// sensor posts congestion at a fixed edge rate. Reports throughput and latency percentiles as JSON.
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -15,7 +15,10 @@ struct ServeBenchConfig {
   double congestion_edges_per_s = 1000.0;
   int congestion_requests_per_s = 10;
   double seconds = 10.0;
-  int client_threads = 4;
+  // Position reports per second over all vehicles, paced evenly; 0 sends back to back (the
+  // server's saturation throughput).
+  double rate_per_s = 0.0;
+  int client_threads = 1;
   int server_threads = 2;
   std::uint64_t seed = 1;
 };
