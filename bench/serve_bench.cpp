@@ -77,6 +77,8 @@ class LoadConnection {
     req_.keep_alive(true);
   }
   void start() { schedule(); }
+  // Sees each successful response's body (on the client thread that read it).
+  void on_body(std::function<void(const std::string&)> f) { on_body_ = std::move(f); }
   [[nodiscard]] const std::vector<double>& latencies_ms() const { return latencies_ms_; }
   [[nodiscard]] std::uint64_t errors() const { return errors_; }
 
@@ -100,7 +102,11 @@ class LoadConnection {
       http::async_read(stream_, buffer_, res_, [this](beast::error_code read_ec, std::size_t) {
         if (read_ec) return fail();
         latencies_ms_.push_back(std::chrono::duration<double, std::milli>(Clock::now() - due_).count());
-        if (res_.result_int() != 200) ++errors_;
+        if (res_.result_int() != 200) {
+          ++errors_;
+        } else if (on_body_) {
+          on_body_(res_.body());
+        }
         due_ += period_;
         schedule();
       });
@@ -111,6 +117,7 @@ class LoadConnection {
   beast::tcp_stream stream_;
   net::steady_timer timer_;
   std::function<std::string()> next_body_;
+  std::function<void(const std::string&)> on_body_;
   Clock::duration period_;
   Clock::time_point deadline_;
   Clock::time_point due_;
@@ -221,6 +228,10 @@ json run_serve_bench(const maps::RoadGraph& graph, const ServeBenchConfig& c) {
         return json{{"updates", updates}}.dump();
       },
       1.0 / c.congestion_requests_per_s, deadline, started);
+  std::vector<double> replan_latency_ms;  // per congestion request: until its last mission is repaired
+  sensor.on_body([&](const std::string& body) {
+    replan_latency_ms.push_back(json::parse(body).value("replan_latency_ms", 0.0));
+  });
   for (auto& v : vehicles) v->start();
   if (per_request > 0) sensor.start();
   std::vector<std::thread> clients;
@@ -252,6 +263,9 @@ json run_serve_bench(const maps::RoadGraph& graph, const ServeBenchConfig& c) {
   out["positions"]["p99_ms"] = percentile(all, 0.99);
   out["congestion"] = latency_json(congestion_ms);
   out["congestion"]["p99_ms"] = percentile(congestion_ms, 0.99);
+  // Server side, per request: from its arrival to the last mission's repaired route.
+  out["congestion"]["replan_latency_ms"] = latency_json(replan_latency_ms);
+  out["congestion"]["replan_latency_ms"]["p99_ms"] = percentile(replan_latency_ms, 0.99);
   out["congestion"]["edges_per_s"] = static_cast<double>(congestion_ms.size()) *
                                      (c.congestion_edges_per_s / c.congestion_requests_per_s) / elapsed;
   out["errors"] = errors;

@@ -393,6 +393,7 @@ std::vector<EdgeId> DispatchService::resolve_edges(const CongestionUpdate& u) co
 }
 
 CongestionResult DispatchService::report_congestion(const std::vector<CongestionUpdate>& updates, double now_s) {
+  const auto started = std::chrono::steady_clock::now();
   if (updates.empty()) throw bad_request("updates must hold at least one update");
   if (updates.size() > 10000) throw bad_request("at most 10000 updates per request");
   // Validate everything before changing anything: a request applies whole or not at all.
@@ -456,7 +457,7 @@ CongestionResult DispatchService::report_congestion(const std::vector<Congestion
     emit("congestion_applied", 0, std::to_string(changed.size()) + " edges", now_s);
   }
   std::vector<std::shared_ptr<CommitTicket>> durable;
-  CongestionResult result = repair_plans(affected, now_s, durable);
+  CongestionResult result = repair_plans(affected, now_s, started, durable);
   result.edges_changed = changed.size();
   for (const auto& t : durable) t->wait();
   return result;
@@ -475,6 +476,7 @@ std::vector<MissionId> DispatchService::notify_planners(const std::vector<EdgeId
 }
 
 CongestionResult DispatchService::repair_plans(const std::vector<MissionId>& missions, double now_s,
+                                               std::chrono::steady_clock::time_point started,
                                                std::vector<std::shared_ptr<CommitTicket>>& durable) {
   CongestionResult result;
   // One mission per lock: position reports for other missions go between them, so a large
@@ -501,6 +503,7 @@ CongestionResult DispatchService::repair_plans(const std::vector<MissionId>& mis
     }
     durable.push_back(submit_staged());
   }
+  result.replan_latency_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;
 }
 
@@ -533,7 +536,7 @@ void DispatchService::tick(double now_s) {
   }
   // Nobody waits for the tick's writes; a failure is logged by the queue.
   std::vector<std::shared_ptr<CommitTicket>> durable;
-  repair_plans(affected, now_s, durable);
+  repair_plans(affected, now_s, std::chrono::steady_clock::now(), durable);
   std::lock_guard lock(mutex_);
   const DropUnsubmitted drop{staged_};
   signals_.advance(now_s);

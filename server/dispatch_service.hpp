@@ -5,6 +5,7 @@
 // durable. Transport-free, so request handling can be tested and fuzzed without sockets.
 #pragma once
 
+#include <chrono>
 #include <functional>
 #include <map>
 #include <memory>
@@ -87,7 +88,7 @@ class DispatchService {
   // returns the missions to repair.
   std::vector<MissionId> notify_planners(const std::vector<EdgeId>& changed, const std::string& reason);
   // Repairs those plans one mission per lock and publishes new routes; collects the write tickets.
-  CongestionResult repair_plans(const std::vector<MissionId>& missions, double now_s,
+  CongestionResult repair_plans(const std::vector<MissionId>& missions, double now_s, std::chrono::steady_clock::time_point started,
                                 std::vector<std::shared_ptr<CommitTicket>>& durable);
   void drain_preemption_events();
   void emit(const std::string& kind, MissionId mission, const std::string& reason, double now_s);

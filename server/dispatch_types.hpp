@@ -76,6 +76,9 @@ struct CongestionResult {
   std::size_t edges_changed = 0;
   std::size_t missions_replanned = 0;
   std::size_t routes_changed = 0;
+  // From the call's start to the last mission's repaired route: what a dispatcher waits, at most,
+  // to see the effect of a congestion report (before its writes are durable).
+  double replan_latency_s = 0;
 };
 
 // What the service tells listeners (the WebSocket stream): kind and mission, with a JSON payload
