@@ -23,6 +23,24 @@ CommitQueue::Write insert(const std::string& vehicle, double timestamp_s) {
   return [p = report(vehicle, timestamp_s)](Store& s) { s.insert_position(p, std::nullopt, p.timestamp_s); };
 }
 
+// Holds the writer thread inside a write until release(), so that what is submitted meanwhile
+// queues up behind it.
+class HeldWriter {
+ public:
+  explicit HeldWriter(CommitQueue& queue) {
+    queue.submit([this, gate = release_.get_future().share()](Store&) {
+      busy_.set_value();
+      gate.wait();
+    });
+    busy_.get_future().wait();
+  }
+  void release() { release_.set_value(); }
+
+ private:
+  std::promise<void> release_;
+  std::promise<void> busy_;
+};
+
 TEST(CommitQueue, WritesCommitInSubmissionOrder) {
   TempDb db;
   Store store(db.path());
@@ -39,17 +57,11 @@ TEST(CommitQueue, WritesQueuedDuringACommitShareTheNextTransaction) {
   TempDb db;
   Store store(db.path());
   CommitQueue queue(store);
-  std::promise<void> release;
-  std::promise<void> writer_busy;
   // The first write holds the writer while 300 more arrive; they must commit together.
-  queue.submit([&, gate = release.get_future().share()](Store&) {
-    writer_busy.set_value();
-    gate.wait();
-  });
-  writer_busy.get_future().wait();
+  HeldWriter held(queue);
   std::vector<std::shared_ptr<CommitTicket>> tickets;
   for (int i = 0; i < 300; ++i) tickets.push_back(queue.submit(insert("amb-1", i)));
-  release.set_value();
+  held.release();
   for (const auto& t : tickets) t->wait();
   const auto stats = queue.stats();
   EXPECT_EQ(stats.writes, 301u);
@@ -62,17 +74,11 @@ TEST(CommitQueue, AFailingWriteFailsOnlyItsOwnTicket) {
   TempDb db;
   Store store(db.path());
   CommitQueue queue(store);
-  std::promise<void> release;
-  std::promise<void> writer_busy;
-  queue.submit([&, gate = release.get_future().share()](Store&) {
-    writer_busy.set_value();
-    gate.wait();
-  });
-  writer_busy.get_future().wait();
+  HeldWriter held(queue);  // so that all three share one batch
   auto before = queue.submit(insert("amb-1", 1.0));
   auto bad = queue.submit([](Store&) { throw StoreError("disk full"); });
   auto after = queue.submit(insert("amb-1", 2.0));
-  release.set_value();
+  held.release();
   EXPECT_NO_THROW(before->wait());
   EXPECT_THROW(bad->wait(), StoreError);
   EXPECT_NO_THROW(after->wait());
