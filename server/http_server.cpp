@@ -216,7 +216,7 @@ struct HttpServer::Impl {
 
   void accept() {
     acceptor.async_accept(net::make_strand(ioc), [this](beast::error_code ec, tcp::socket socket) {
-      if (!acceptor.is_open()) return;
+      if (!acceptor.is_open() || ec == net::error::operation_aborted) return;  // stopping
       if (!ec) {
         std::make_shared<HttpSession>(std::move(socket), router, hub, limits)->run();
         accept();
