@@ -56,12 +56,13 @@ void run_serve(const ServeOptions& o) {
   const nlohmann::json config = read_config(o.config);
 
   server::TokenAuth auth;
+  std::string dev_token;
   try {
     auth.add_from_config(config);
     const char* env = std::getenv("CORRIDOR_DEV_TOKEN");
     const std::string dev = env != nullptr && *env != '\0' ? std::string(env) : random_token();
     auth.add(dev, {"development", server::kAllRoles, std::nullopt});
-    std::cout << "development token (all roles): " << dev << std::endl;
+    dev_token = dev;
   } catch (const server::AuthConfigError& e) {
     throw UsageError(e.what());
   }
@@ -84,6 +85,9 @@ void run_serve(const ServeOptions& o) {
   server::DispatchService service(graph, maps::signal_plans_for(map_file, graph), {}, &store, now());
   server::Router router(service, std::move(auth), router_config, now);
   server::HttpServer http(router, service, limits, host, static_cast<unsigned short>(port), o.threads);
+  // Printed only once the database and the port are ours, so a server that cannot start shows
+  // its error and no token.
+  std::cout << "development token (all roles): " << dev_token << std::endl;
   std::cout << "listening on http://" << host << ":" << http.port() << " (map: " << graph.node_count() << " nodes, "
             << service.active_mission_count() << " active missions resumed, db: " << o.db << ")" << std::endl;
   spdlog::info("event=serving address={}:{} threads={}", host, http.port(), o.threads);

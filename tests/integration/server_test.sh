@@ -51,6 +51,12 @@ start_server
 check "development token printed" "grep -q 'development token (all roles): $TOKEN' '$work/serve.out'"
 check "token never in logs" "! grep -q '$TOKEN' '$work/serve.err'"
 check "health" "[[ \$(api GET /v1/health) == 200 ]]"
+# A second server on the same database is refused with a clear error, and prints no token.
+"$corridor" serve --db "$work/corridor.db" --listen 127.0.0.1:0 > "$work/second.out" 2> "$work/second.err"
+second_rc=$?
+check "second server on the same database refused" "[[ $second_rc -ne 0 ]] && grep -q 'in use by another corridor server' '$work/second.err'"
+check "refused server prints no token" "! grep -q 'development token' '$work/second.out'"
+check "first server unaffected" "[[ \$(api GET /v1/health) == 200 ]]"
 
 # A WebSocket client listens for the whole scenario.
 python3 "$here/ws_listen.py" 127.0.0.1 "$port" viewer-token-0123456789abcdef 120 > "$work/ws.txt" &
