@@ -272,6 +272,13 @@ HttpServer::HttpServer(Router& router, DispatchService& service, ServerLimits li
 
 HttpServer::~HttpServer() {
   stop();
+  // Answers still waiting for their commit hand their response to a session's executor: let them
+  // do that while the io_context is still alive (stopped, it only queues and then drops them).
+  try {
+    impl_->service.flush();
+  } catch (const std::exception& e) {
+    spdlog::error("event=flush_failed error=\"{}\"", e.what());
+  }
   impl_->service.unsubscribe(impl_->subscription);  // the hub dies with this server
 }
 
