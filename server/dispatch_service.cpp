@@ -227,18 +227,12 @@ MissionView DispatchService::create_mission(const MissionRequest& req, double no
     m->route = m->planner->route();
     if (!m->route.found) throw unprocessable("unreachable", "the destination cannot be reached from the origin");
 
+    m->row.id = next_mission_id_;
+    stage([row = m->row](Store& store) { store.insert_mission(row); });
+    persist_route(*m, "dispatch", now_s);
     // The database first: if it fails, nothing was shared and the request fails whole.
-    if (commits_) {
-      const std::string geometry = planner::route_to_geojson(graph_, m->route, "dstar")["geometry"].dump();
-      commits_->run([&](Store& store) {
-        m->row.id = store.insert_mission(m->row);
-        store.insert_route_revision(m->row.id, 1, "dispatch", m->route.travel_time_s, m->route.length_m, geometry, now_s);
-      });
-      m->revision = 1;
-    } else {
-      m->row.id = next_memory_id_++;
-      persist_route(*m, "dispatch", now_s);
-    }
+    submit_staged()->wait();
+    ++next_mission_id_;
     Mission& ref = *m;
     missions_[ref.row.id] = std::move(m);
     active_by_vehicle_[ref.row.vehicle_id] = ref.row.id;
@@ -275,8 +269,11 @@ DispatchService::Mission& DispatchService::active(MissionId id) {
   return *it->second;
 }
 
-void DispatchService::finish(Mission& m, MissionState state, double now_s, bool stage_state) {
-  if (stage_state) stage([id = m.row.id, state, now_s](Store& store) { store.update_mission_state(id, state, now_s); });
+void DispatchService::stage_state(const Mission& m, MissionState state, double now_s) {
+  stage([id = m.row.id, state, now_s](Store& store) { store.update_mission_state(id, state, now_s); });
+}
+
+void DispatchService::finish(Mission& m, MissionState state, double now_s) {
   m.row.state = state;
   m.row.updated_s = now_s;
   active_by_vehicle_.erase(m.row.vehicle_id);
@@ -296,8 +293,9 @@ MissionView DispatchService::cancel_mission(MissionId id, double now_s) {
     const DropUnsubmitted drop{staged_};
     Mission& m = active(id);
     // Stored first: if that fails, the mission is still active everywhere.
-    if (commits_) commits_->run([&](Store& store) { store.update_mission_state(id, MissionState::cancelled, now_s); });
-    finish(m, MissionState::cancelled, now_s, false);
+    stage_state(m, MissionState::cancelled, now_s);
+    submit_staged()->wait();
+    finish(m, MissionState::cancelled, now_s);
     durable = submit_staged();
     cancelled = view(m);
   }
@@ -360,7 +358,8 @@ PositionResult DispatchService::report_position(const PositionReport& p, double 
   if (!m.route.found || m.route.length_m <= config_.arrival_radius_m ||
       maps::distance_m(snap.point, m.destination_local) <= config_.arrival_radius_m) {
     result.completed = true;
-    finish(m, MissionState::completed, now_s, true);
+    stage_state(m, MissionState::completed, now_s);
+    finish(m, MissionState::completed, now_s);
   } else {
     // The route changed if it is not the rest of the old one from the vehicle's edge on.
     const auto from = std::find(old_edges.begin(), old_edges.end(), m.route.edges.front());
@@ -574,6 +573,7 @@ void DispatchService::restore(double now_s) {
     if (c.expires_at_s) expiries_.emplace(*c.expires_at_s, std::make_pair(c.edge, seq));
   }
   for (const MissionRow& row : store_->missions(std::nullopt)) {
+    next_mission_id_ = std::max(next_mission_id_, row.id + 1);
     const auto last = store_->last_position(row.vehicle_id);
     if (row.state != MissionState::active) {
       // Finished missions stay readable; they need no planner.

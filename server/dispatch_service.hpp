@@ -93,8 +93,9 @@ class DispatchService {
   void drain_preemption_events();
   void emit(const std::string& kind, MissionId mission, const std::string& reason, double now_s);
   MissionView view(const Mission& m) const;
-  // `stage_state` false: the caller has already stored the new state.
-  void finish(Mission& m, MissionState state, double now_s, bool stage_state);
+  // Ends a mission in memory; the caller stores the new state (stage_state) first.
+  void finish(Mission& m, MissionState state, double now_s);
+  void stage_state(const Mission& m, MissionState state, double now_s);
   // Writes staged under the lock go to the commit queue together, in order, as one ticket.
   void stage(CommitQueue::Write write);
   std::shared_ptr<CommitTicket> submit_staged();
@@ -122,7 +123,7 @@ class DispatchService {
   std::uint64_t update_sequence_ = 0;
   std::map<std::size_t, Listener> listeners_;
   std::size_t next_listener_ = 1;
-  MissionId next_memory_id_ = 1;
+  MissionId next_mission_id_ = 1;  // after the highest stored id
   mutable std::mutex mutex_;
   // Serializes congestion changes and expiries end to end (taken before mutex_, never after).
   std::mutex congestion_mutex_;

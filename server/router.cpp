@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <future>
 #include <sstream>
 
 #include "maps/errors.hpp"
@@ -214,20 +215,11 @@ HttpResponse Router::storage_failure(const std::string& route_name, const std::s
 }
 
 HttpResponse Router::handle(const HttpRequest& request) noexcept {
-  const auto started = std::chrono::steady_clock::now();
-  std::string route_name = "unmatched";
-  HttpResponse response = answer(request, route_name);
-  if (response.after_commit) {
-    try {
-      response.after_commit->wait();
-      response.after_commit.reset();
-    } catch (const std::exception& e) {
-      response = storage_failure(route_name, e.what());
-    }
-  }
-  metrics_.observe_request(route_name, response.status,
-                           std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
-  return response;
+  // handle_async always replies exactly once, so the future always gets its value.
+  std::promise<HttpResponse> answered;
+  auto response = answered.get_future();
+  handle_async(request, [&answered](HttpResponse r) { answered.set_value(std::move(r)); });
+  return response.get();
 }
 
 void Router::handle_async(const HttpRequest& request, std::function<void(HttpResponse)> reply) noexcept {

@@ -296,16 +296,15 @@ void Store::Transaction::commit() {
   done_ = true;
 }
 
-MissionId Store::insert_mission(const MissionRow& r) {
-  Statement s(cached("INSERT INTO missions(vehicle_id, priority, vmax_kmh, dest_lat, dest_lon, origin_lat, origin_lon, state, "
-                     "created_s, updated_s) VALUES (?,?,?,?,?,?,?,?,?,?)"));
-  s.bind(1, r.vehicle_id).bind(2, static_cast<std::int64_t>(r.priority)).bind(3, r.vmax_kmh);
-  s.bind(4, r.destination.lat_deg).bind(5, r.destination.lon_deg);
-  s.bind(6, r.origin ? std::optional<double>(r.origin->lat_deg) : std::nullopt);
-  s.bind(7, r.origin ? std::optional<double>(r.origin->lon_deg) : std::nullopt);
-  s.bind(8, std::string(to_string(r.state))).bind(9, r.created_s).bind(10, r.updated_s);
+void Store::insert_mission(const MissionRow& r) {
+  Statement s(cached("INSERT INTO missions(id, vehicle_id, priority, vmax_kmh, dest_lat, dest_lon, origin_lat, origin_lon, "
+                     "state, created_s, updated_s) VALUES (?,?,?,?,?,?,?,?,?,?,?)"));
+  s.bind(1, static_cast<std::int64_t>(r.id)).bind(2, r.vehicle_id).bind(3, static_cast<std::int64_t>(r.priority));
+  s.bind(4, r.vmax_kmh).bind(5, r.destination.lat_deg).bind(6, r.destination.lon_deg);
+  s.bind(7, r.origin ? std::optional<double>(r.origin->lat_deg) : std::nullopt);
+  s.bind(8, r.origin ? std::optional<double>(r.origin->lon_deg) : std::nullopt);
+  s.bind(9, std::string(to_string(r.state))).bind(10, r.created_s).bind(11, r.updated_s);
   s.step();
-  return static_cast<MissionId>(sqlite3_last_insert_rowid(db_));
 }
 
 void Store::update_mission_state(MissionId id, MissionState state, double time_s) {

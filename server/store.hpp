@@ -82,7 +82,8 @@ class Store {
     bool done_ = false;
   };
 
-  MissionId insert_mission(const MissionRow& row);
+  // Under the row's own id (the service numbers missions, so it knows the id before storing).
+  void insert_mission(const MissionRow& row);
   void update_mission_state(MissionId id, MissionState state, double time_s);
   void insert_position(const PositionReport& report, std::optional<MissionId> mission, double received_s);
   void insert_route_revision(MissionId mission, std::uint32_t revision, const std::string& reason, double eta_s,

@@ -246,6 +246,9 @@ TEST(DispatchService, PersistsAndResumesActiveMissionsAfterRestart) {
   EXPECT_NE(resumed.last_position->lat_deg, request("x").origin->lat_deg);
   EXPECT_EQ(service.mission(cancelled).state, MissionState::cancelled);
   EXPECT_EQ(code_of([&] { service.create_mission(request("amb-a"), 10.0); }), 409);
+  // New missions are numbered after every stored one.
+  EXPECT_EQ(service.create_mission(request("amb-c"), 10.0).id, std::max(kept, cancelled) + 1);
+  EXPECT_EQ(store.count("missions"), 3u);
   // Congestion still in force applies to the resumed planner.
   planner::CostOverlay overlay(grid());
   overlay.set_signal_delay(grid(), DispatchConfig{}.signal_delay_s);
