@@ -28,6 +28,8 @@ std::optional<MissionState> mission_state_from(const std::string& s) {
 }
 
 struct DispatchService::Mission {
+  // Confines everything below but the pending changes: one request works on a mission at a time.
+  mutable std::mutex mutex;
   MissionRow row;
   std::optional<maps::LatLon> last_position;
   maps::Point2 destination_local;
@@ -36,9 +38,13 @@ struct DispatchService::Mission {
   planner::Route route;
   std::uint32_t revision = 0;
   std::vector<preemption::ScheduleEntry> final_schedule;  // kept when the engine forgets the mission
-  // Set when edge costs changed and the plan has not been repaired since: the reason to give if
-  // the repaired route differs.
-  std::optional<std::string> unrepaired_change;
+
+  // Edges whose cost changed since the planner last heard, and the reason to give if the repaired
+  // route differs. Appended under the overlay's exclusive lock, taken under its shared lock, so a
+  // repair sees exactly the costs it was told of.
+  std::mutex pending_mutex;
+  std::vector<EdgeId> pending_edges;
+  std::optional<std::string> pending_reason;
 };
 
 namespace {
@@ -58,18 +64,13 @@ double bearing_deg(const maps::RoadGraph& g, EdgeId e, double offset_m) {
   return std::fmod(std::atan2(b.x_m - a.x_m, b.y_m - a.y_m) * 180.0 / M_PI + 360.0, 360.0);
 }
 
-// Drops the writes a call staged if it fails half-way: what is not acknowledged is not stored.
-struct DropUnsubmitted {
-  std::vector<CommitQueue::Write>& staged;
-  ~DropUnsubmitted() { staged.clear(); }
-};
-
 double angle_between_deg(double a, double b) {
   const double d = std::fmod(std::abs(a - b), 360.0);
   return d > 180.0 ? 360.0 - d : d;
 }
 
 }  // namespace
+
 
 DispatchService::DispatchService(const maps::RoadGraph& graph, DispatchConfig config, Store* store, double now_s)
     : DispatchService(graph, maps::default_signal_plans(graph), config, store, now_s) {}
@@ -80,8 +81,8 @@ DispatchService::DispatchService(const maps::RoadGraph& graph, std::unordered_ma
       config_(config),
       store_(store),
       snapper_(graph),
-      overlay_(graph),
       plans_(std::move(plans)),
+      overlay_(graph),
       signals_(plans_, now_s),
       preemption_(graph, plans_, signals_, config.preemption) {
   overlay_.set_signal_delay(graph, config_.signal_delay_s);
@@ -95,13 +96,9 @@ DispatchService::DispatchService(const maps::RoadGraph& graph, std::unordered_ma
 // Queued writes hold copies of what they store, so the queue may drain after the rest is gone.
 DispatchService::~DispatchService() = default;
 
-void DispatchService::stage(CommitQueue::Write write) {
-  if (commits_) staged_.push_back(std::move(write));
-}
-
-std::shared_ptr<CommitTicket> DispatchService::submit_staged() {
-  if (!commits_ || staged_.empty()) return CommitTicket::done();
-  return commits_->submit([writes = std::exchange(staged_, {})](Store& store) {
+std::shared_ptr<CommitTicket> DispatchService::submit(Staged& staged) {
+  if (!commits_ || staged.empty()) return CommitTicket::done();
+  return commits_->submit([writes = std::exchange(staged, {})](Store& store) {
     for (const auto& w : writes) w(store);
   });
 }
@@ -116,18 +113,19 @@ std::optional<CommitQueue::Stats> DispatchService::commit_stats() const {
 }
 
 std::size_t DispatchService::subscribe(Listener listener) {
-  std::lock_guard lock(mutex_);
+  std::lock_guard lock(listeners_mutex_);
   listeners_[next_listener_] = std::move(listener);
   return next_listener_++;
 }
 
 void DispatchService::unsubscribe(std::size_t id) {
-  std::lock_guard lock(mutex_);
+  std::lock_guard lock(listeners_mutex_);
   listeners_.erase(id);
 }
 
 void DispatchService::emit(const std::string& kind, MissionId mission, const std::string& reason, double now_s) {
   const DispatchEvent event{kind, mission, reason, now_s};
+  std::lock_guard lock(listeners_mutex_);
   for (const auto& [id, l] : listeners_) l(event);
 }
 
@@ -152,153 +150,202 @@ MissionView DispatchService::view(const Mission& m) const {
   v.last_position = m.last_position;
   v.route = m.route;
   v.route_revision = m.revision;
-  v.schedule = m.row.state == MissionState::active ? preemption_.schedule(m.row.id) : m.final_schedule;
+  if (m.row.state == MissionState::active) {
+    std::lock_guard lock(preemption_mutex_);
+    v.schedule = preemption_.schedule(m.row.id);
+  } else {
+    v.schedule = m.final_schedule;
+  }
   v.created_s = m.row.created_s;
   v.updated_s = m.row.updated_s;
   return v;
 }
 
-void DispatchService::drain_preemption_events() {
+void DispatchService::drain_preemption_events(Staged& staged) {
   for (const auto& e : preemption_.take_events()) {
-    stage([e](Store& store) { store.insert_preemption_event(e); });
+    if (commits_) staged.push_back([e](Store& store) { store.insert_preemption_event(e); });
     emit("preemption_" + e.kind, e.mission, e.detail, e.time_s);
   }
 }
 
-void DispatchService::persist_route(Mission& m, const std::string& reason, double now_s) {
+std::optional<std::string> DispatchService::repair(Mission& m, const std::vector<planner::EdgePoint>* new_start) {
+  std::shared_lock costs(overlay_mutex_);
+  std::vector<EdgeId> changed;
+  std::optional<std::string> reason;
+  {
+    std::lock_guard lock(m.pending_mutex);
+    changed = std::exchange(m.pending_edges, {});
+    reason = std::exchange(m.pending_reason, std::nullopt);
+  }
+  // D* Lite must hear of each change exactly once, before its next repair.
+  if (!changed.empty()) m.planner->edges_changed(changed);
+  if (new_start != nullptr) m.planner->move_start(*new_start);
+  m.planner->replan();
+  m.route = m.planner->route();
+  return reason;
+}
+
+void DispatchService::persist_route(Mission& m, const std::string& reason, double now_s, Staged& staged) {
   if (commits_) {
-    stage([id = m.row.id, revision = m.revision + 1, reason, eta = m.route.travel_time_s, length = m.route.length_m,
-           geometry = planner::route_to_geojson(graph_, m.route, "dstar")["geometry"].dump(), now_s](Store& store) {
-      store.insert_route_revision(id, revision, reason, eta, length, geometry, now_s);
+    // The geometry is rendered by the writer thread, off the request's path; the graph outlives the queue.
+    staged.push_back([&graph = graph_, id = m.row.id, revision = m.revision + 1, reason, route = m.route, now_s](Store& store) {
+      store.insert_route_revision(id, revision, reason, route.travel_time_s, route.length_m,
+                                  planner::route_to_geojson(graph, route, "dstar")["geometry"].dump(), now_s);
     });
   }
   ++m.revision;
   m.row.updated_s = now_s;
 }
 
-void DispatchService::announce_route(Mission& m, const std::string& reason, double now_s) {
+void DispatchService::retime_signals(Mission& m, double now_s, Staged& staged) {
   const auto crossings = preemption::signalized_crossings(m.route, plans_, now_s);
+  std::lock_guard lock(preemption_mutex_);
   preemption_.update_route(m.row.id, m.row.priority, crossings, now_s);
+  drain_preemption_events(staged);
+}
+
+void DispatchService::announce_route(Mission& m, const std::string& reason, double now_s, Staged& staged) {
   emit(m.revision == 1 ? "mission_created" : "route_changed", m.row.id, reason, now_s);
-  drain_preemption_events();
+  retime_signals(m, now_s, staged);
 }
 
 MissionView DispatchService::create_mission(const MissionRequest& req, double now_s) {
   if (req.vehicle_id.empty() || req.vehicle_id.size() > 64) throw bad_request("vehicle_id must be 1 to 64 characters");
   if (!(req.vmax_kmh >= 5.0 && req.vmax_kmh <= 250.0)) throw bad_request("vmax_kmh must be between 5 and 250");
   if (req.priority < 0 || req.priority > 10) throw bad_request("priority must be between 0 and 10");
-  std::shared_ptr<CommitTicket> durable;
-  MissionView created;
+  std::lock_guard creating(create_mutex_);
+  std::optional<maps::LatLon> origin = req.origin;
   {
-    std::lock_guard lock(mutex_);
-    const DropUnsubmitted drop{staged_};
+    std::shared_lock lock(registry_mutex_);
     if (active_by_vehicle_.count(req.vehicle_id) != 0) {
       throw conflict("vehicle '" + req.vehicle_id + "' already has active mission " +
                      std::to_string(active_by_vehicle_.at(req.vehicle_id)) + "; cancel it first");
     }
-    std::optional<maps::LatLon> origin = req.origin;
     if (!origin) {
       if (auto it = last_position_.find(req.vehicle_id); it != last_position_.end()) origin = it->second;
     }
-    if (!origin) {
-      throw unprocessable("no_origin", "vehicle '" + req.vehicle_id +
-                                           "' has no known position: post one to /v1/vehicles/{id}/position or give origin");
-    }
-    maps::SnapResult from, to;
-    try {
-      from = snapper_.snap(*origin, {config_.snap_max_distance_m});
-    } catch (const maps::SnapError& e) {
-      throw snap_error(e, "origin");
-    }
-    try {
-      to = snapper_.snap(req.destination, {config_.snap_max_distance_m});
-    } catch (const maps::SnapError& e) {
-      throw snap_error(e, "destination");
-    }
+  }
+  if (!origin) {
+    throw unprocessable("no_origin", "vehicle '" + req.vehicle_id +
+                                         "' has no known position: post one to /v1/vehicles/{id}/position or give origin");
+  }
+  maps::SnapResult from, to;
+  try {
+    from = snapper_.snap(*origin, {config_.snap_max_distance_m});
+  } catch (const maps::SnapError& e) {
+    throw snap_error(e, "origin");
+  }
+  try {
+    to = snapper_.snap(req.destination, {config_.snap_max_distance_m});
+  } catch (const maps::SnapError& e) {
+    throw snap_error(e, "destination");
+  }
 
-    auto m = std::make_unique<Mission>();
-    m->row = {0, req.vehicle_id, req.priority, req.vmax_kmh, req.destination, origin, MissionState::active, now_s, now_s};
-    m->last_position = origin;
-    m->destination_local = to.point;
-    m->cost = std::make_unique<planner::TravelCost>(graph_, overlay_, planner::VehicleProfile{req.vmax_kmh / 3.6});
+  auto m = std::make_shared<Mission>();
+  std::unique_lock mission_lock(m->mutex);
+  m->row = {next_mission_id_, req.vehicle_id, req.priority, req.vmax_kmh, req.destination, origin, MissionState::active, now_s, now_s};
+  m->last_position = origin;
+  m->destination_local = to.point;
+  m->cost = std::make_unique<planner::TravelCost>(graph_, overlay_, planner::VehicleProfile{req.vmax_kmh / 3.6});
+  Staged staged;
+  {
+    // Planned and registered under one view of the costs, so no congestion change falls between.
+    std::shared_lock costs(overlay_mutex_);
     m->planner = std::make_unique<planner::DStarLite>(*m->cost, endpoints(from, Role::start, std::nullopt),
-                                                            endpoints(to, Role::goal, std::nullopt));
+                                                      endpoints(to, Role::goal, std::nullopt));
     m->planner->replan();
     m->route = m->planner->route();
     if (!m->route.found) throw unprocessable("unreachable", "the destination cannot be reached from the origin");
-
-    m->row.id = next_mission_id_;
-    stage([row = m->row](Store& store) { store.insert_mission(row); });
-    persist_route(*m, "dispatch", now_s);
+    if (commits_) staged.push_back([row = m->row](Store& store) { store.insert_mission(row); });
+    persist_route(*m, "dispatch", now_s, staged);
     // The database first: if it fails, nothing was shared and the request fails whole.
-    submit_staged()->wait();
+    submit(staged)->wait();
     ++next_mission_id_;
-    Mission& ref = *m;
-    missions_[ref.row.id] = std::move(m);
-    active_by_vehicle_[ref.row.vehicle_id] = ref.row.id;
-    announce_route(ref, "dispatch", now_s);
-    durable = submit_staged();
-    created = view(ref);
+    std::lock_guard lock(registry_mutex_);
+    missions_[m->row.id] = m;
+    active_by_vehicle_[m->row.vehicle_id] = m->row.id;
   }
+  announce_route(*m, "dispatch", now_s, staged);
+  auto durable = submit(staged);
+  MissionView created = view(*m);
+  mission_lock.unlock();
   durable->wait();
   return created;
 }
 
 MissionView DispatchService::mission(MissionId id) const {
-  std::lock_guard lock(mutex_);
-  auto it = missions_.find(id);
-  if (it == missions_.end()) throw not_found("no mission " + std::to_string(id));
-  return view(*it->second);
+  MissionPtr m;
+  {
+    std::shared_lock lock(registry_mutex_);
+    auto it = missions_.find(id);
+    if (it == missions_.end()) throw not_found("no mission " + std::to_string(id));
+    m = it->second;
+  }
+  std::lock_guard lock(m->mutex);
+  return view(*m);
 }
 
 std::vector<MissionView> DispatchService::missions(std::optional<MissionState> state) const {
-  std::lock_guard lock(mutex_);
+  std::vector<MissionPtr> all;
+  {
+    std::shared_lock lock(registry_mutex_);
+    for (const auto& [id, m] : missions_) all.push_back(m);
+  }
   std::vector<MissionView> out;
-  for (const auto& [id, m] : missions_) {
+  for (const auto& m : all) {
+    std::lock_guard lock(m->mutex);
     if (!state || m->row.state == *state) out.push_back(view(*m));
   }
   return out;
 }
 
-DispatchService::Mission& DispatchService::active(MissionId id) {
+DispatchService::MissionPtr DispatchService::find(MissionId id) const {
+  std::shared_lock lock(registry_mutex_);
   auto it = missions_.find(id);
   if (it == missions_.end()) throw not_found("no mission " + std::to_string(id));
-  if (it->second->row.state != MissionState::active) {
-    throw conflict("mission " + std::to_string(id) + " is already " + to_string(it->second->row.state));
+  return it->second;
+}
+
+void DispatchService::require_active(const Mission& m) {
+  if (m.row.state != MissionState::active) {
+    throw conflict("mission " + std::to_string(m.row.id) + " is already " + to_string(m.row.state));
   }
-  return *it->second;
 }
 
-void DispatchService::stage_state(const Mission& m, MissionState state, double now_s) {
-  stage([id = m.row.id, state, now_s](Store& store) { store.update_mission_state(id, state, now_s); });
+void DispatchService::stage_state(const Mission& m, MissionState state, double now_s, Staged& staged) {
+  staged.push_back([id = m.row.id, state, now_s](Store& store) { store.update_mission_state(id, state, now_s); });
 }
 
-void DispatchService::finish(Mission& m, MissionState state, double now_s) {
+void DispatchService::finish(Mission& m, MissionState state, double now_s, Staged& staged) {
   m.row.state = state;
   m.row.updated_s = now_s;
-  active_by_vehicle_.erase(m.row.vehicle_id);
-  preemption_.cancel(m.row.id, now_s);
-  m.final_schedule = preemption_.schedule(m.row.id);
-  preemption_.forget(m.row.id, now_s);
   m.planner.reset();  // a finished mission keeps its last route, not its search state
+  {
+    std::lock_guard lock(preemption_mutex_);
+    preemption_.cancel(m.row.id, now_s);
+    m.final_schedule = preemption_.schedule(m.row.id);
+    preemption_.forget(m.row.id, now_s);
+    drain_preemption_events(staged);
+  }
+  {
+    std::lock_guard lock(registry_mutex_);
+    active_by_vehicle_.erase(m.row.vehicle_id);
+  }
   emit(state == MissionState::completed ? "mission_completed" : "mission_cancelled", m.row.id, "", now_s);
-  drain_preemption_events();
 }
 
 MissionView DispatchService::cancel_mission(MissionId id, double now_s) {
-  std::shared_ptr<CommitTicket> durable;
-  MissionView cancelled;
-  {
-    std::lock_guard lock(mutex_);
-    const DropUnsubmitted drop{staged_};
-    Mission& m = active(id);
-    // Stored first: if that fails, the mission is still active everywhere.
-    stage_state(m, MissionState::cancelled, now_s);
-    submit_staged()->wait();
-    finish(m, MissionState::cancelled, now_s);
-    durable = submit_staged();
-    cancelled = view(m);
-  }
+  const MissionPtr m = find(id);
+  std::unique_lock lock(m->mutex);
+  require_active(*m);
+  Staged staged;
+  // Stored first: if that fails, the mission is still active everywhere.
+  if (commits_) stage_state(*m, MissionState::cancelled, now_s, staged);
+  submit(staged)->wait();
+  finish(*m, MissionState::cancelled, now_s, staged);
+  auto durable = submit(staged);
+  MissionView cancelled = view(*m);
+  lock.unlock();
   durable->wait();
   return cancelled;
 }
@@ -321,20 +368,28 @@ PositionResult DispatchService::report_position(const PositionReport& p, double 
     throw snap_error(e, "position");
   }
 
-  std::lock_guard lock(mutex_);
-  const DropUnsubmitted drop{staged_};
   PositionResult result;
   result.snap_distance_m = snap.distance_m;
-  last_position_[p.vehicle_id] = p.position;
-  auto it = active_by_vehicle_.find(p.vehicle_id);
-  if (it == active_by_vehicle_.end()) {
-    stage([p, now_s](Store& store) { store.insert_position(p, std::nullopt, now_s); });
-    result.durable = submit_staged();
+  MissionPtr mp;
+  {
+    std::lock_guard lock(registry_mutex_);
+    last_position_[p.vehicle_id] = p.position;
+    if (auto it = active_by_vehicle_.find(p.vehicle_id); it != active_by_vehicle_.end()) mp = missions_.at(it->second);
+  }
+  Staged staged;
+  std::unique_lock<std::mutex> lock;
+  if (mp) {
+    lock = std::unique_lock(mp->mutex);
+    if (mp->row.state != MissionState::active) mp.reset();  // it ended in between
+  }
+  if (!mp) {
+    if (commits_) staged.push_back([p, now_s](Store& store) { store.insert_position(p, std::nullopt, now_s); });
+    result.durable = submit(staged);
     return result;
   }
-  Mission& m = *missions_.at(it->second);
+  Mission& m = *mp;
   result.mission = m.row.id;
-  stage([p, id = m.row.id, now_s](Store& store) { store.insert_position(p, id, now_s); });
+  if (commits_) staged.push_back([p, id = m.row.id, now_s](Store& store) { store.insert_position(p, id, now_s); });
   m.last_position = p.position;
 
   // Signals behind the vehicle: every intersection of the old route before its current edge.
@@ -344,34 +399,32 @@ PositionResult DispatchService::report_position(const PositionReport& p, double 
   });
   if (pos_in_route != m.route.edges.end()) {
     const auto passed = static_cast<std::size_t>(pos_in_route - m.route.edges.begin());
+    std::lock_guard signals(preemption_mutex_);
     for (std::size_t i = 0; i < passed && i < m.route.nodes.size(); ++i) preemption_.vehicle_passed(m.row.id, m.route.nodes[i], now_s);
   }
 
   const std::vector<EdgeId> old_edges = m.route.edges;
-  m.planner->move_start(points);
-  m.planner->replan();
   // This repair also covers any cost change the planner heard of since its last one.
-  const std::string reason = std::exchange(m.unrepaired_change, std::nullopt).value_or("off_route");
-  m.route = m.planner->route();
+  const std::string reason = repair(m, &points).value_or("off_route");
   result.eta_s = m.route.travel_time_s;
   emit("position", m.row.id, p.source, now_s);
   if (!m.route.found || m.route.length_m <= config_.arrival_radius_m ||
       maps::distance_m(snap.point, m.destination_local) <= config_.arrival_radius_m) {
     result.completed = true;
-    stage_state(m, MissionState::completed, now_s);
-    finish(m, MissionState::completed, now_s);
+    if (commits_) stage_state(m, MissionState::completed, now_s, staged);
+    finish(m, MissionState::completed, now_s, staged);
   } else {
     // The route changed if it is not the rest of the old one from the vehicle's edge on.
     const auto from = std::find(old_edges.begin(), old_edges.end(), m.route.edges.front());
     result.route_changed = !std::equal(from, old_edges.end(), m.route.edges.begin(), m.route.edges.end());
     if (result.route_changed) {
-      publish_route(m, reason, now_s);
+      persist_route(m, reason, now_s, staged);
+      announce_route(m, reason, now_s, staged);
     } else {
-      preemption_.update_route(m.row.id, m.row.priority, preemption::signalized_crossings(m.route, plans_, now_s), now_s);
-      drain_preemption_events();
+      retime_signals(m, now_s, staged);
     }
   }
-  result.durable = submit_staged();
+  result.durable = submit(staged);
   return result;
 }
 
@@ -427,12 +480,11 @@ CongestionResult DispatchService::report_congestion(const std::vector<Congestion
     }
   }
 
-  // One congestion change at a time, end to end, so that the database and the planners see the
-  // same order; positions do not wait for it.
+  // One congestion change at a time, end to end; positions do not wait for it.
   std::lock_guard serial(congestion_mutex_);
   {
-    // A speed or factor update keeps the edge's queue delay; read it under the lock.
-    std::lock_guard lock(mutex_);
+    // A speed or factor update keeps the edge's queue delay.
+    std::shared_lock costs(overlay_mutex_);
     for (auto& [e, condition] : changes) condition.queue_delay_s = overlay_.edge(e).queue_delay_s;
   }
   // Persist the whole batch before applying any of it, so a storage failure changes nothing.
@@ -441,74 +493,70 @@ CongestionResult DispatchService::report_congestion(const std::vector<Congestion
       for (std::size_t i = 0; i < changes.size(); ++i) store.insert_congestion(changes[i].first, changes[i].second, expiry[i], now_s);
     });
   }
-  std::vector<MissionId> affected;
-  std::vector<EdgeId> changed;
-  {
-    std::lock_guard lock(mutex_);
-    for (std::size_t i = 0; i < changes.size(); ++i) {
-      overlay_.set_edge(changes[i].first, changes[i].second);
-      changed.push_back(changes[i].first);
-      const std::uint64_t seq = ++update_sequence_;
-      latest_update_[changes[i].first] = seq;
-      if (expiry[i]) expiries_.emplace(*expiry[i], std::make_pair(changes[i].first, seq));
-    }
-    affected = notify_planners(changed, "congestion");
-    emit("congestion_applied", 0, std::to_string(changed.size()) + " edges", now_s);
+  for (std::size_t i = 0; i < changes.size(); ++i) {
+    const std::uint64_t seq = ++update_sequence_;
+    latest_update_[changes[i].first] = seq;
+    if (expiry[i]) expiries_.emplace(*expiry[i], std::make_pair(changes[i].first, seq));
   }
+  const std::vector<MissionPtr> affected = apply_changes(changes, "congestion");
+  emit("congestion_applied", 0, std::to_string(changes.size()) + " edges", now_s);
   std::vector<std::shared_ptr<CommitTicket>> durable;
   CongestionResult result = repair_plans(affected, now_s, started, durable);
-  result.edges_changed = changed.size();
+  result.edges_changed = changes.size();
   for (const auto& t : durable) t->wait();
   return result;
 }
 
-std::vector<MissionId> DispatchService::notify_planners(const std::vector<EdgeId>& changed, const std::string& reason) {
-  // D* Lite must hear of each change exactly once, before its next repair.
-  std::vector<MissionId> affected;
-  for (auto& [id, m] : missions_) {
-    if (m->row.state != MissionState::active) continue;
-    m->planner->edges_changed(changed);
-    m->unrepaired_change = reason;
-    affected.push_back(id);
+std::vector<DispatchService::MissionPtr> DispatchService::apply_changes(
+    const std::vector<std::pair<EdgeId, planner::EdgeCondition>>& changes, const std::string& reason) {
+  std::vector<EdgeId> edges;
+  edges.reserve(changes.size());
+  for (const auto& [e, condition] : changes) edges.push_back(e);
+  std::vector<MissionPtr> affected;
+  std::lock_guard costs(overlay_mutex_);
+  for (const auto& [e, condition] : changes) overlay_.set_edge(e, condition);
+  std::shared_lock registry(registry_mutex_);
+  for (const auto& [vehicle, id] : active_by_vehicle_) {
+    const MissionPtr& m = missions_.at(id);
+    std::lock_guard lock(m->pending_mutex);
+    m->pending_edges.insert(m->pending_edges.end(), edges.begin(), edges.end());
+    m->pending_reason = reason;
+    affected.push_back(m);
   }
   return affected;
 }
 
-CongestionResult DispatchService::repair_plans(const std::vector<MissionId>& missions, double now_s,
+CongestionResult DispatchService::repair_plans(const std::vector<MissionPtr>& missions, double now_s,
                                                std::chrono::steady_clock::time_point started,
                                                std::vector<std::shared_ptr<CommitTicket>>& durable) {
   CongestionResult result;
-  // One mission per lock: position reports for other missions go between them, so a large
-  // congestion batch does not stall the whole fleet.
-  for (MissionId id : missions) {
-    std::lock_guard lock(mutex_);
-    const DropUnsubmitted drop{staged_};
-    auto it = missions_.find(id);
-    if (it == missions_.end() || it->second->row.state != MissionState::active) continue;
-    Mission& m = *it->second;
+  // One mission lock at a time: reports for other missions go on meanwhile.
+  for (const MissionPtr& mp : missions) {
+    Mission& m = *mp;
+    std::lock_guard lock(m.mutex);
+    if (m.row.state != MissionState::active) continue;
     ++result.missions_replanned;
-    if (!m.unrepaired_change) continue;  // a position report repaired it in the meantime
-    const std::string reason = *std::exchange(m.unrepaired_change, std::nullopt);
     const std::vector<EdgeId> before = m.route.edges;
-    m.planner->replan();
-    m.route = m.planner->route();
+    const std::optional<std::string> reason = repair(m, nullptr);
+    if (!reason) continue;  // a position report repaired it in the meantime
+    Staged staged;
     if (m.route.edges != before) {
       ++result.routes_changed;
-      publish_route(m, reason, now_s);
+      persist_route(m, *reason, now_s, staged);
+      announce_route(m, *reason, now_s, staged);
     } else {
       // Same route, new costs: the arrival times moved, so the signals are re-timed.
-      preemption_.update_route(id, m.row.priority, preemption::signalized_crossings(m.route, plans_, now_s), now_s);
-      drain_preemption_events();
+      retime_signals(m, now_s, staged);
     }
-    durable.push_back(submit_staged());
+    durable.push_back(submit(staged));
   }
   result.replan_latency_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;
 }
 
 void DispatchService::report_counts(NodeId node, maps::Compass approach, double arrivals, double departures, double now_s) {
-  std::lock_guard lock(mutex_);
   if (plans_.count(node) == 0) throw not_found("no signal at node " + std::to_string(node.v));
+  std::lock_guard lock(preemption_mutex_);
   try {
     preemption_.record_counts(node, approach, now_s, arrivals, departures);
   } catch (const preemption::CountError& e) {
@@ -517,42 +565,42 @@ void DispatchService::report_counts(NodeId node, maps::Compass approach, double 
 }
 
 void DispatchService::tick(double now_s) {
-  std::lock_guard serial(congestion_mutex_);
-  std::vector<MissionId> affected;
   {
-    std::lock_guard lock(mutex_);
-    std::vector<EdgeId> expired;
+    std::lock_guard serial(congestion_mutex_);
+    std::vector<std::pair<EdgeId, planner::EdgeCondition>> expired;
     while (!expiries_.empty() && expiries_.begin()->first <= now_s) {
       const auto [e, seq] = expiries_.begin()->second;
       expiries_.erase(expiries_.begin());
       // An expiry ends only the update it came with; a later update of the edge stays in force.
       if (latest_update_[e] != seq) continue;
       latest_update_.erase(e);
-      overlay_.reset_edge(e);
-      expired.push_back(e);
+      expired.push_back({e, planner::EdgeCondition{}});
     }
-    if (!expired.empty()) affected = notify_planners(expired, "congestion_expired");
+    if (!expired.empty()) {
+      // Nobody waits for the tick's writes; a failure is logged by the queue.
+      std::vector<std::shared_ptr<CommitTicket>> durable;
+      repair_plans(apply_changes(expired, "congestion_expired"), now_s, std::chrono::steady_clock::now(), durable);
+    }
   }
-  // Nobody waits for the tick's writes; a failure is logged by the queue.
-  std::vector<std::shared_ptr<CommitTicket>> durable;
-  repair_plans(affected, now_s, std::chrono::steady_clock::now(), durable);
-  std::lock_guard lock(mutex_);
-  const DropUnsubmitted drop{staged_};
-  signals_.advance(now_s);
-  preemption_.tick(now_s);
-  drain_preemption_events();
-  submit_staged();
+  Staged staged;
+  {
+    std::lock_guard lock(preemption_mutex_);
+    signals_.advance(now_s);
+    preemption_.tick(now_s);
+    drain_preemption_events(staged);
+  }
+  submit(staged);
 }
 
 std::vector<preemption::Light> DispatchService::signal_lights(NodeId node) const {
-  std::lock_guard lock(mutex_);
   if (plans_.count(node) == 0) throw not_found("no signal at node " + std::to_string(node.v));
+  std::lock_guard lock(preemption_mutex_);
   return signals_.lights(node);
 }
 
 std::pair<std::string, std::size_t> DispatchService::signal_mode(NodeId node) const {
-  std::lock_guard lock(mutex_);
   if (plans_.count(node) == 0) throw not_found("no signal at node " + std::to_string(node.v));
+  std::lock_guard lock(preemption_mutex_);
   const char* mode = signals_.mode(node) == preemption::SignalMode::held ? "held"
                      : signals_.running_program(node)                    ? "program"
                                                                          : "clearing";
@@ -560,10 +608,11 @@ std::pair<std::string, std::size_t> DispatchService::signal_mode(NodeId node) co
 }
 
 std::size_t DispatchService::active_mission_count() const {
-  std::lock_guard lock(mutex_);
+  std::shared_lock lock(registry_mutex_);
   return active_by_vehicle_.size();
 }
 
+// Runs in the constructor, before the service is shared: no locks needed.
 void DispatchService::restore(double now_s) {
   for (const CongestionRow& c : store_->congestion_in_force(now_s)) {
     if (c.edge.index() >= graph_.edge_count()) continue;  // recorded against another map
@@ -572,12 +621,13 @@ void DispatchService::restore(double now_s) {
     latest_update_[c.edge] = seq;
     if (c.expires_at_s) expiries_.emplace(*c.expires_at_s, std::make_pair(c.edge, seq));
   }
+  Staged staged;
   for (const MissionRow& row : store_->missions(std::nullopt)) {
     next_mission_id_ = std::max(next_mission_id_, row.id + 1);
     const auto last = store_->last_position(row.vehicle_id);
     if (row.state != MissionState::active) {
       // Finished missions stay readable; they need no planner.
-      auto m = std::make_unique<Mission>();
+      auto m = std::make_shared<Mission>();
       m->row = row;
       if (last) m->last_position = last->position;
       missions_[row.id] = std::move(m);
@@ -587,7 +637,7 @@ void DispatchService::restore(double now_s) {
     try {
       const auto from = snapper_.snap(start, {config_.snap_max_distance_m});
       const auto to = snapper_.snap(row.destination, {config_.snap_max_distance_m});
-      auto m = std::make_unique<Mission>();
+      auto m = std::make_shared<Mission>();
       m->row = row;
       m->last_position = start;
       m->destination_local = to.point;
@@ -597,17 +647,17 @@ void DispatchService::restore(double now_s) {
           endpoints(to, Role::goal, std::nullopt));
       m->planner->replan();
       m->route = m->planner->route();
-      Mission& ref = *m;
-      missions_[row.id] = std::move(m);
+      missions_[row.id] = m;
       active_by_vehicle_[row.vehicle_id] = row.id;
       last_position_[row.vehicle_id] = start;
-      publish_route(ref, "restart", now_s);
+      persist_route(*m, "restart", now_s, staged);
+      announce_route(*m, "restart", now_s, staged);
       spdlog::info("event=mission_resumed mission={} vehicle={}", row.id, row.vehicle_id);
     } catch (const maps::SnapError& e) {
       spdlog::error("event=mission_not_resumable mission={} reason=\"{}\"", row.id, e.what());
     }
   }
-  submit_staged()->wait();
+  submit(staged)->wait();
 }
 
 }  // namespace corridor::server

@@ -10,6 +10,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <shared_mutex>
 #include <unordered_map>
 
 #include "maps/edge_snapper.hpp"
@@ -72,61 +73,82 @@ class DispatchService {
 
  private:
   struct Mission;
+  using MissionPtr = std::shared_ptr<Mission>;
+  // The writes of one call, submitted to the commit queue together, in order, as one ticket.
+  using Staged = std::vector<CommitQueue::Write>;
 
-  Mission& active(MissionId id);
+  // The active mission, or ApiError; the registry lock is released on return.
+  MissionPtr find(MissionId id) const;
+  static void require_active(const Mission& m);
   enum class Role { start, goal };
   std::vector<planner::EdgePoint> endpoints(const maps::SnapResult& snap, Role role, std::optional<double> heading_deg) const;
+  // Brings a mission's plan up to date with the costs and its start (under the mission's lock);
+  // returns the reason of a cost change it had not repaired yet, if any.
+  std::optional<std::string> repair(Mission& m, const std::vector<planner::EdgePoint>* new_start);
   // A new route revision: persist_route stages its write; announce_route re-times the signals
   // and tells the listeners.
-  void persist_route(Mission& m, const std::string& reason, double now_s);
-  void announce_route(Mission& m, const std::string& reason, double now_s);
-  void publish_route(Mission& m, const std::string& reason, double now_s) {
-    persist_route(m, reason, now_s);
-    announce_route(m, reason, now_s);
-  }
-  // Tells every active mission's planner that `changed` edges changed cost (under the lock);
-  // returns the missions to repair.
-  std::vector<MissionId> notify_planners(const std::vector<EdgeId>& changed, const std::string& reason);
-  // Repairs those plans one mission per lock and publishes new routes; collects the write tickets.
-  CongestionResult repair_plans(const std::vector<MissionId>& missions, double now_s, std::chrono::steady_clock::time_point started,
+  void persist_route(Mission& m, const std::string& reason, double now_s, Staged& staged);
+  void announce_route(Mission& m, const std::string& reason, double now_s, Staged& staged);
+  void retime_signals(Mission& m, double now_s, Staged& staged);
+  // Applies edge changes to the overlay and tells every active planner of them; returns those missions.
+  std::vector<MissionPtr> apply_changes(const std::vector<std::pair<EdgeId, planner::EdgeCondition>>& changes,
+                                        const std::string& reason);
+  // Repairs those plans, one mission lock at a time, and publishes new routes; collects the write tickets.
+  CongestionResult repair_plans(const std::vector<MissionPtr>& missions, double now_s, std::chrono::steady_clock::time_point started,
                                 std::vector<std::shared_ptr<CommitTicket>>& durable);
-  void drain_preemption_events();
+  // Under preemption_mutex_.
+  void drain_preemption_events(Staged& staged);
   void emit(const std::string& kind, MissionId mission, const std::string& reason, double now_s);
   MissionView view(const Mission& m) const;
   // Ends a mission in memory; the caller stores the new state (stage_state) first.
-  void finish(Mission& m, MissionState state, double now_s);
-  void stage_state(const Mission& m, MissionState state, double now_s);
-  // Writes staged under the lock go to the commit queue together, in order, as one ticket.
-  void stage(CommitQueue::Write write);
-  std::shared_ptr<CommitTicket> submit_staged();
+  void finish(Mission& m, MissionState state, double now_s, Staged& staged);
+  static void stage_state(const Mission& m, MissionState state, double now_s, Staged& staged);
+  std::shared_ptr<CommitTicket> submit(Staged& staged);
   std::vector<EdgeId> resolve_edges(const CongestionUpdate& u) const;
   void restore(double now_s);
 
+  // Locks, always taken in this order (never one while holding a later one):
+  //   create_mutex_ | congestion_mutex_  ->  Mission::mutex  ->  overlay_mutex_  ->  preemption_mutex_
+  //   ->  registry_mutex_  ->  Mission::pending_mutex  ->  listeners_mutex_
+  // Each mission's planner is confined to its own Mission::mutex, so missions are served in parallel.
   const maps::RoadGraph& graph_;
   DispatchConfig config_;
   Store* store_;
-  std::unique_ptr<CommitQueue> commits_;    // null without a store
-  std::vector<CommitQueue::Write> staged_;  // this call's writes, not yet submitted
+  std::unique_ptr<CommitQueue> commits_;  // null without a store
   maps::EdgeSnapper snapper_;
+  const std::unordered_map<NodeId, maps::SignalPlan> plans_;
+  std::unordered_multimap<std::int64_t, EdgeId> edges_by_way_;
+
+  // Read by every planner's repair (shared), written by congestion changes (exclusive).
+  mutable std::shared_mutex overlay_mutex_;
   planner::CostOverlay overlay_;
-  std::unordered_map<NodeId, maps::SignalPlan> plans_;
+
+  // The signals and the engine that arbitrates between missions.
+  mutable std::mutex preemption_mutex_;
   preemption::SimulatedSignalController signals_;
   preemption::PreemptionEngine preemption_;
-  std::unordered_multimap<std::int64_t, EdgeId> edges_by_way_;
-  std::map<MissionId, std::unique_ptr<Mission>> missions_;
+
+  mutable std::shared_mutex registry_mutex_;
+  std::map<MissionId, MissionPtr> missions_;
   std::unordered_map<std::string, MissionId> active_by_vehicle_;
   std::unordered_map<std::string, maps::LatLon> last_position_;
+
+  // Serializes mission creation (rare): one vehicle never gets two active missions.
+  std::mutex create_mutex_;
+  MissionId next_mission_id_ = 1;  // after the highest stored id
+
+  // Serializes congestion changes and expiries end to end, so that the database and the planners
+  // see the same order; guards the expiry bookkeeping.
+  std::mutex congestion_mutex_;
   // Expiry time -> (edge, update sequence); an expiry resets the edge only if it belongs to the
   // edge's latest update.
   std::multimap<double, std::pair<EdgeId, std::uint64_t>> expiries_;
   std::unordered_map<EdgeId, std::uint64_t> latest_update_;
   std::uint64_t update_sequence_ = 0;
+
+  mutable std::mutex listeners_mutex_;
   std::map<std::size_t, Listener> listeners_;
   std::size_t next_listener_ = 1;
-  MissionId next_mission_id_ = 1;  // after the highest stored id
-  mutable std::mutex mutex_;
-  // Serializes congestion changes and expiries end to end (taken before mutex_, never after).
-  std::mutex congestion_mutex_;
 };
 
 }  // namespace corridor::server

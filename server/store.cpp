@@ -18,7 +18,7 @@ namespace corridor::server {
 namespace {
 
 // Each entry moves the schema one version up; never edit a released entry, append a new one.
-constexpr std::array<const char*, 1> kMigrations{
+constexpr std::array<const char*, 2> kMigrations{
     R"sql(
     CREATE TABLE missions (
       id INTEGER PRIMARY KEY AUTOINCREMENT,
@@ -65,6 +65,16 @@ constexpr std::array<const char*, 1> kMigrations{
       kind TEXT NOT NULL,
       detail TEXT NOT NULL,
       time_s REAL NOT NULL);
+    )sql",
+    // v2: the index on positions(vehicle_id, id) made every position write touch that vehicle's own
+    // index leaf, a WAL frame per vehicle per transaction. The latest position of each vehicle is
+    // all that is looked up by vehicle, and a small table of those stays on a few hot pages.
+    R"sql(
+    CREATE TABLE vehicle_last_position (
+      vehicle_id TEXT PRIMARY KEY,
+      position_id INTEGER NOT NULL) WITHOUT ROWID;
+    INSERT INTO vehicle_last_position(vehicle_id, position_id) SELECT vehicle_id, MAX(id) FROM positions GROUP BY vehicle_id;
+    DROP INDEX positions_vehicle;
     )sql",
 };
 
@@ -127,8 +137,10 @@ class Statement {
 
 // Copies the WAL back into the database file on its own connection and thread, so that no commit
 // waits for a checkpoint's fsync. PASSIVE checkpoints never block the writer, but under sustained
-// load the writer never finds the WAL fully copied, so SQLite never rewinds it; past the hard limit
-// a RESTART checkpoint (a short stall of the writer, after PASSIVE copied the bulk) rewinds it.
+// load the writer never finds the WAL fully copied, so SQLite never rewinds it. Past the hard limit
+// the writer itself runs a RESTART between two transactions, once no PASSIVE is running: a short
+// stall, since PASSIVE copied the bulk, and a bound that holds however busy the machine is (a
+// RESTART from this thread would poll for the write lock and could lose to a busy writer for long).
 class Store::Checkpointer {
  public:
   static constexpr int kCheckpointFrames = 1000;  // SQLite's own auto-checkpoint threshold
@@ -162,8 +174,13 @@ class Store::Checkpointer {
   Checkpointer& operator=(const Checkpointer&) = delete;
 
   // Called by SQLite on the writer's thread after each commit.
-  static int on_commit(void* self, sqlite3*, const char*, int wal_frames) {
-    if (wal_frames >= kCheckpointFrames) static_cast<Checkpointer*>(self)->request();
+  static int on_commit(void* self, sqlite3* writer, const char*, int wal_frames) {
+    auto* c = static_cast<Checkpointer*>(self);
+    if (wal_frames > kHardLimitFrames) {
+      c->restart(writer, wal_frames);
+    } else if (wal_frames >= kCheckpointFrames) {
+      c->request();
+    }
     return SQLITE_OK;
   }
 
@@ -175,22 +192,38 @@ class Store::Checkpointer {
     }
     cv_.notify_one();
   }
+  void restart(sqlite3* writer, int wal_frames) {
+    {
+      std::lock_guard lock(mutex_);
+      held_ = true;  // no new PASSIVE starts; the one running finishes first
+      if (running_) return;  // the next commit tries again
+    }
+    spdlog::debug("event=wal_restart_checkpoint wal_frames={}", wal_frames);
+    int frames = 0;
+    int copied = 0;
+    if (sqlite3_wal_checkpoint_v2(writer, nullptr, SQLITE_CHECKPOINT_RESTART, &frames, &copied) != SQLITE_OK) {
+      spdlog::warn("event=checkpoint_failed mode=restart error=\"{}\"", sqlite3_errmsg(writer));
+    }
+    {
+      std::lock_guard lock(mutex_);
+      held_ = false;
+    }
+    cv_.notify_one();
+  }
   void loop() {
     std::unique_lock lock(mutex_);
     for (;;) {
-      cv_.wait(lock, [&] { return stopping_ || wanted_; });
+      cv_.wait(lock, [&] { return stopping_ || (wanted_ && !held_); });
       if (stopping_) return;
       wanted_ = false;
+      running_ = true;
       lock.unlock();
       int wal_frames = 0;
       int copied = 0;
-      int rc = sqlite3_wal_checkpoint_v2(db_, nullptr, SQLITE_CHECKPOINT_PASSIVE, &wal_frames, &copied);
-      if (rc == SQLITE_OK && wal_frames > kHardLimitFrames) {
-        spdlog::debug("event=wal_restart_checkpoint wal_frames={}", wal_frames);
-        rc = sqlite3_wal_checkpoint_v2(db_, nullptr, SQLITE_CHECKPOINT_RESTART, &wal_frames, &copied);
-      }
-      if (rc != SQLITE_OK && rc != SQLITE_BUSY) spdlog::warn("event=checkpoint_failed error=\"{}\"", sqlite3_errmsg(db_));
+      const int rc = sqlite3_wal_checkpoint_v2(db_, nullptr, SQLITE_CHECKPOINT_PASSIVE, &wal_frames, &copied);
+      if (rc != SQLITE_OK && rc != SQLITE_BUSY) spdlog::warn("event=checkpoint_failed mode=passive error=\"{}\"", sqlite3_errmsg(db_));
       lock.lock();
+      running_ = false;
     }
   }
 
@@ -199,6 +232,8 @@ class Store::Checkpointer {
   std::mutex mutex_;
   std::condition_variable cv_;
   bool wanted_ = false;
+  bool running_ = false;  // a PASSIVE checkpoint is copying
+  bool held_ = false;     // the writer waits to RESTART
   bool stopping_ = false;
 };
 
@@ -319,6 +354,9 @@ void Store::insert_position(const PositionReport& p, std::optional<MissionId> mi
   s.bind(2, mission ? std::optional<double>(static_cast<double>(*mission)) : std::nullopt);
   s.bind(3, p.position.lat_deg).bind(4, p.position.lon_deg).bind(5, p.heading_deg).bind(6, p.speed_mps).bind(7, p.hdop);
   s.bind(8, p.timestamp_s).bind(9, p.source).bind(10, received_s).step();
+  Statement latest(cached("INSERT INTO vehicle_last_position(vehicle_id, position_id) VALUES (?, last_insert_rowid()) "
+                          "ON CONFLICT(vehicle_id) DO UPDATE SET position_id = excluded.position_id"));
+  latest.bind(1, p.vehicle_id).step();
 }
 
 void Store::insert_route_revision(MissionId mission, std::uint32_t revision, const std::string& reason, double eta_s,
@@ -367,7 +405,9 @@ std::vector<MissionRow> Store::missions(std::optional<MissionState> state) const
 }
 
 std::optional<PositionRow> Store::last_position(const std::string& vehicle_id) const {
-  Statement s(db_, "SELECT lat, lon, heading_deg, timestamp_s FROM positions WHERE vehicle_id = ? ORDER BY id DESC LIMIT 1");
+  Statement s(db_,
+              "SELECT p.lat, p.lon, p.heading_deg, p.timestamp_s FROM vehicle_last_position v "
+              "JOIN positions p ON p.id = v.position_id WHERE v.vehicle_id = ?");
   s.bind(1, vehicle_id);
   if (!s.step()) return std::nullopt;
   return PositionRow{vehicle_id, {s.real(0), s.real(1)}, s.optional_real(2), s.real(3)};

@@ -134,12 +134,13 @@ TEST(Store, CheckpointsKeepTheWalBoundedUnderSustainedWrites) {
   TempDb db;
   Store store(db.path());
   CommitQueue queue(store);
-  // 4,000 commits of two pages or more each: without checkpoints the WAL would pass 40 MB. The
-  // checkpointer rewinds it at about 16 MB.
-  for (int i = 0; i < 4000; ++i) queue.submit(insert("amb-" + std::to_string(i % 50), i))->wait();
-  EXPECT_EQ(store.count("positions"), 4000u);
+  // 8,000 commits of two pages or more each: without checkpoints the WAL would pass 80 MB. The
+  // writer rewinds it past about 16 MB, once the PASSIVE checkpoint running then is done; on a
+  // busy machine that one may take a while, hence the margin.
+  for (int i = 0; i < 8000; ++i) queue.submit(insert("amb-" + std::to_string(i % 50), i))->wait();
+  EXPECT_EQ(store.count("positions"), 8000u);
   const auto wal = std::filesystem::file_size(db.path().string() + "-wal");
-  EXPECT_LT(wal, 20u << 20) << "WAL of " << wal << " bytes";
+  EXPECT_LT(wal, 32u << 20) << "WAL of " << wal << " bytes";
   EXPECT_GT(std::filesystem::file_size(db.path()), 100u << 10) << "checkpoints should have moved pages into the database";
 }
 

@@ -4,7 +4,10 @@
 #include <sqlite3.h>
 
 #include <filesystem>
+#include <atomic>
+#include <map>
 #include <random>
+#include <thread>
 
 #include "maps/synthetic_grid.hpp"
 #include "planner/one_to_one_search.hpp"
@@ -168,6 +171,90 @@ TEST(DispatchService, CongestionOnTheRouteChangesIt) {
   EXPECT_EQ(service.mission(m.id).route.edges, m.route.edges);
 }
 
+// Missions are served in parallel (one lock per mission), so several threads post positions,
+// congestion, counts and reads at once; afterwards every plan must still be the optimal route
+// under the final costs (the Dijkstra oracle), and every position must be stored. Run under TSan too.
+TEST(DispatchService, ConcurrentReportsKeepEveryPlanOptimal) {
+  TempDb db;
+  Store store(db.path());
+  DispatchService service(grid(), {}, &store, 0.0);
+  const auto n = static_cast<std::uint32_t>(grid().node_count());
+  std::mt19937 rng(5);
+  const auto pick = [&](std::uint32_t from) { return NodeId{from + static_cast<std::uint32_t>(rng() % (n / 2))}; };
+  std::vector<MissionId> ids;
+  for (int i = 0; i < 8; ++i) {
+    MissionRequest r = request("amb-" + std::to_string(i));
+    r.origin = node_ll(pick(0));
+    r.destination = node_ll(pick(n / 2));
+    ids.push_back(service.create_mission(r, 0.0).id);
+  }
+  std::atomic<int> positions{0};
+  std::atomic<double> clock{1.0};
+  const auto now = [&] { return clock.fetch_add(0.01); };
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 4; ++t) {
+    threads.emplace_back([&, t] {
+      for (int k = 0; k < 150; ++k) {
+        for (int v = 2 * t; v < 2 * t + 2; ++v) {
+          const MissionView m = service.mission(ids[static_cast<std::size_t>(v)]);
+          if (m.state != MissionState::active || m.route.edges.size() < 4) continue;
+          // Mostly on its current edge; now and then half way along the next one: it drives on.
+          const EdgeId e = m.route.edges[k % 10 == 9 ? 1 : 0];
+          PositionReport p;
+          p.vehicle_id = m.vehicle_id;
+          p.position = grid().projection().to_lat_lon(grid().point_along(e, grid().length_m(e) / 2));
+          p.timestamp_s = now();
+          service.report_position(p, p.timestamp_s).durable->wait();
+          ++positions;
+        }
+      }
+    });
+  }
+  std::map<EdgeId, double> final_factor;  // written by the congestion thread only, read after join
+  threads.emplace_back([&] {
+    std::mt19937 r(9);
+    std::uniform_real_distribution<double> factor(0.6, 6.0);
+    for (int k = 0; k < 300; ++k) {
+      std::vector<CongestionUpdate> batch;
+      for (int j = 0; j < 6; ++j) {
+        CongestionUpdate u;
+        u.edge = EdgeId{static_cast<std::uint32_t>(r() % grid().edge_count())};
+        u.factor = factor(r);
+        final_factor[*u.edge] = *u.factor;
+        batch.push_back(u);
+      }
+      service.report_congestion(batch, now());
+    }
+  });
+  threads.emplace_back([&] {
+    for (int k = 0; k < 200; ++k) {
+      EXPECT_LE(service.missions(MissionState::active).size(), ids.size());
+      for (const auto& [node, plan] : service.signal_plans()) {
+        EXPECT_FALSE(service.signal_mode(node).first.empty());
+        break;
+      }
+      service.tick(now());
+    }
+  });
+  for (auto& t : threads) t.join();
+  service.flush();
+  EXPECT_EQ(store.count("positions"), static_cast<std::size_t>(positions.load()));
+
+  planner::CostOverlay overlay(grid());
+  overlay.set_signal_delay(grid(), DispatchConfig{}.signal_delay_s);
+  for (const auto& [e, f] : final_factor) overlay.set_edge(e, {f, 0.0});
+  const planner::TravelCost cost(grid(), overlay, {120.0 / 3.6});
+  planner::OneToOneSearch dijkstra;
+  int checked = 0;
+  for (const MissionView& m : service.missions(MissionState::active)) {
+    const auto oracle = dijkstra.run(planner::SearchSpace(cost, {m.route.start}, {m.route.goal}), false);
+    EXPECT_NEAR(oracle.travel_time_s, m.route.travel_time_s, 1e-6 * oracle.travel_time_s) << "mission " << m.id;
+    ++checked;
+  }
+  EXPECT_GT(checked, 0);
+  EXPECT_GT(positions.load(), 300);
+}
+
 // An expiry ends only the update it came with: a later closure without expiry stays in force.
 TEST(DispatchService, OldExpiryDoesNotReopenALaterClosure) {
   DispatchService service(grid(), {}, nullptr, 0.0);
@@ -235,7 +322,7 @@ TEST(DispatchService, PersistsAndResumesActiveMissionsAfterRestart) {
     EXPECT_GT(store.count("preemption_events"), 0u);
   }  // the process "dies" here: nothing is flushed beyond what each call committed
   Store store(db.path());
-  EXPECT_EQ(store.schema_version(), 1);
+  EXPECT_EQ(store.schema_version(), 2);
   DispatchService service(grid(), {}, &store, 10.0);
   EXPECT_EQ(service.active_mission_count(), 1u);
   const MissionView resumed = service.mission(kept);
@@ -259,12 +346,53 @@ TEST(DispatchService, PersistsAndResumesActiveMissionsAfterRestart) {
   EXPECT_NEAR(oracle.travel_time_s, resumed.route.travel_time_s, 1e-6);
 }
 
+TEST(Store, MigratesVersion1PositionsToEachVehiclesLatest) {
+  TempDb db;
+  PositionReport p;
+  p.vehicle_id = "amb-a";
+  {
+    Store store(db.path());
+    for (int i = 0; i < 3; ++i) {
+      p.position = {43.73 + 0.001 * i, 7.42};
+      p.timestamp_s = i;
+      store.insert_position(p, std::nullopt, i);
+    }
+    p.vehicle_id = "amb-b";
+    p.position = {43.70, 7.40};
+    store.insert_position(p, std::nullopt, 5.0);
+  }
+  // Back to the version-1 layout: the per-vehicle index, no table of latest positions.
+  sqlite3* raw = nullptr;
+  ASSERT_EQ(sqlite3_open(db.path().c_str(), &raw), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(raw,
+                         "DROP TABLE vehicle_last_position; CREATE INDEX positions_vehicle ON positions(vehicle_id, id);"
+                         "DELETE FROM schema_migrations WHERE version = 2;",
+                         nullptr, nullptr, nullptr),
+            SQLITE_OK);
+  sqlite3_close(raw);
+  Store store(db.path());
+  EXPECT_EQ(store.schema_version(), 2);
+  const auto a = store.last_position("amb-a");
+  ASSERT_TRUE(a.has_value());
+  EXPECT_DOUBLE_EQ(a->position.lat_deg, 43.732);
+  EXPECT_DOUBLE_EQ(a->timestamp_s, 2.0);
+  ASSERT_TRUE(store.last_position("amb-b").has_value());
+  EXPECT_DOUBLE_EQ(store.last_position("amb-b")->position.lat_deg, 43.70);
+  EXPECT_FALSE(store.last_position("amb-c").has_value());
+  // Later positions keep it current.
+  p.vehicle_id = "amb-b";
+  p.position = {43.71, 7.41};
+  store.insert_position(p, std::nullopt, 6.0);
+  EXPECT_DOUBLE_EQ(store.last_position("amb-b")->position.lat_deg, 43.71);
+  EXPECT_EQ(store.count("positions"), 5u);
+}
+
 TEST(Store, RefusesADatabaseFromANewerBuild) {
   TempDb db;
   { Store store(db.path()); }
   {
     Store store(db.path());  // reopening an up-to-date database is fine
-    EXPECT_EQ(store.schema_version(), 1);
+    EXPECT_EQ(store.schema_version(), 2);
   }
   sqlite3* raw = nullptr;
   ASSERT_EQ(sqlite3_open(db.path().c_str(), &raw), SQLITE_OK);
