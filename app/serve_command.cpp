@@ -82,7 +82,9 @@ void run_serve(const ServeOptions& o) {
     return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
   };
   const std::filesystem::path map_file = o.map.map_file.empty() ? CORRIDOR_DEFAULT_MAP : o.map.map_file;
-  server::DispatchService service(graph, maps::signal_plans_for(map_file, graph), {}, &store, now());
+  server::DispatchConfig dispatch;
+  dispatch.repair_threads = o.threads;  // as many as serve requests
+  server::DispatchService service(graph, maps::signal_plans_for(map_file, graph), dispatch, &store, now());
   server::Router router(service, std::move(auth), router_config, now);
   server::HttpServer http(router, service, limits, host, static_cast<unsigned short>(port), o.threads);
   // Printed only once the database and the port are ours, so a server that cannot start shows
@@ -104,7 +106,7 @@ void register_serve_command(CLI::App& app) {
   cmd->add_option("--db", o->db, "SQLite database (created if missing)")->capture_default_str();
   cmd->add_option("--listen", o->listen, "HOST:PORT to listen on (port 0 picks a free one)")->capture_default_str();
   cmd->add_option("--config", o->config, "JSON config: tokens with roles, limits");
-  cmd->add_option("--threads", o->threads, "I/O threads")->capture_default_str();
+  cmd->add_option("--threads", o->threads, "I/O threads; as many repair plans in parallel after a congestion change")->capture_default_str();
   cmd->callback([o] { run_serve(*o); });
 }
 

@@ -1,8 +1,13 @@
 #include "server/dispatch_service.hpp"
 
+#include <boost/asio/post.hpp>
+#include <boost/asio/thread_pool.hpp>
 #include <spdlog/spdlog.h>
 
+#include <atomic>
 #include <cmath>
+#include <exception>
+#include <latch>
 
 #include "maps/errors.hpp"
 #include "maps/intersection_geometry.hpp"
@@ -85,8 +90,14 @@ DispatchService::DispatchService(const maps::RoadGraph& graph, std::unordered_ma
       overlay_(graph),
       signals_(plans_, now_s),
       preemption_(graph, plans_, signals_, config.preemption) {
+  if (config_.repair_threads < 1 || config_.repair_threads > 64) {
+    throw std::invalid_argument("repair_threads must be 1 to 64, not " + std::to_string(config_.repair_threads));
+  }
   overlay_.set_signal_delay(graph, config_.signal_delay_s);
   for (EdgeId e : graph.edges()) edges_by_way_.emplace(graph.osm_way(e).v, e);
+  if (config_.repair_threads > 1) {
+    repair_pool_ = std::make_unique<boost::asio::thread_pool>(static_cast<std::size_t>(config_.repair_threads - 1));
+  }
   if (store_ != nullptr) {
     commits_ = std::make_unique<CommitQueue>(*store_);
     restore(now_s);
@@ -94,7 +105,9 @@ DispatchService::DispatchService(const maps::RoadGraph& graph, std::unordered_ma
 }
 
 // Queued writes hold copies of what they store, so the queue may drain after the rest is gone.
-DispatchService::~DispatchService() = default;
+DispatchService::~DispatchService() {
+  if (repair_pool_) repair_pool_->join();
+}
 
 std::shared_ptr<CommitTicket> DispatchService::submit(Staged& staged) {
   if (!commits_ || staged.empty()) return CommitTicket::done();
@@ -526,30 +539,65 @@ std::vector<DispatchService::MissionPtr> DispatchService::apply_changes(
   return affected;
 }
 
+void DispatchService::repair_one(Mission& m, double now_s, CongestionResult& result,
+                                 std::vector<std::shared_ptr<CommitTicket>>& durable) {
+  std::lock_guard lock(m.mutex);
+  if (m.row.state != MissionState::active) return;
+  ++result.missions_replanned;
+  const std::vector<EdgeId> before = m.route.edges;
+  const auto started = std::chrono::steady_clock::now();
+  const std::optional<std::string> reason = repair(m, nullptr);
+  result.slowest_replan_s =
+      std::max(result.slowest_replan_s, std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+  if (!reason) return;  // a position report repaired it in the meantime
+  Staged staged;
+  if (m.route.edges != before) {
+    ++result.routes_changed;
+    persist_route(m, *reason, now_s, staged);
+    announce_route(m, *reason, now_s, staged);
+  } else {
+    // Same route, new costs: the arrival times moved, so the signals are re-timed.
+    retime_signals(m, now_s, staged);
+  }
+  durable.push_back(submit(staged));
+}
+
 CongestionResult DispatchService::repair_plans(const std::vector<MissionPtr>& missions, double now_s,
                                                std::chrono::steady_clock::time_point started,
                                                std::vector<std::shared_ptr<CommitTicket>>& durable) {
   CongestionResult result;
-  // One mission lock at a time: reports for other missions go on meanwhile.
-  for (const MissionPtr& mp : missions) {
-    Mission& m = *mp;
-    std::lock_guard lock(m.mutex);
-    if (m.row.state != MissionState::active) continue;
-    ++result.missions_replanned;
-    const std::vector<EdgeId> before = m.route.edges;
-    const std::optional<std::string> reason = repair(m, nullptr);
-    if (!reason) continue;  // a position report repaired it in the meantime
-    Staged staged;
-    if (m.route.edges != before) {
-      ++result.routes_changed;
-      persist_route(m, *reason, now_s, staged);
-      announce_route(m, *reason, now_s, staged);
-    } else {
-      // Same route, new costs: the arrival times moved, so the signals are re-timed.
-      retime_signals(m, now_s, staged);
+  // The calling thread and the pool's take missions off one counter; a mission's own lock keeps
+  // position reports out of its plan while it is repaired, and lets other missions' reports through.
+  std::atomic<std::size_t> next{0};
+  std::mutex merge_mutex;
+  std::exception_ptr failure;
+  const auto drain = [&] {
+    CongestionResult mine;
+    std::vector<std::shared_ptr<CommitTicket>> tickets;
+    try {
+      for (std::size_t i = next++; i < missions.size(); i = next++) repair_one(*missions[i], now_s, mine, tickets);
+    } catch (...) {
+      std::lock_guard lock(merge_mutex);
+      if (!failure) failure = std::current_exception();
     }
-    durable.push_back(submit(staged));
+    std::lock_guard lock(merge_mutex);
+    result.missions_replanned += mine.missions_replanned;
+    result.routes_changed += mine.routes_changed;
+    result.slowest_replan_s = std::max(result.slowest_replan_s, mine.slowest_replan_s);
+    durable.insert(durable.end(), tickets.begin(), tickets.end());
+  };
+  const std::size_t helpers =
+      repair_pool_ ? std::min(static_cast<std::size_t>(config_.repair_threads - 1), missions.size() / 2) : 0;
+  std::latch helpers_done(static_cast<std::ptrdiff_t>(helpers));
+  for (std::size_t h = 0; h < helpers; ++h) {
+    boost::asio::post(*repair_pool_, [&] {
+      drain();
+      helpers_done.count_down();
+    });
   }
+  drain();
+  helpers_done.wait();
+  if (failure) std::rethrow_exception(failure);
   result.replan_latency_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;
 }

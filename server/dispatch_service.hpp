@@ -23,12 +23,18 @@
 #include "server/dispatch_types.hpp"
 #include "server/store.hpp"
 
+namespace boost::asio {
+class thread_pool;
+}
+
 namespace corridor::server {
 
 struct DispatchConfig {
   double snap_max_distance_m = 200.0;
   double arrival_radius_m = 30.0;  // closer than this to the destination completes the mission
   double signal_delay_s = 15.0;    // expected delay at a signalized intersection, for routing
+  // Threads that repair missions' plans after a congestion change, the calling one included.
+  int repair_threads = 2;
   preemption::PreemptionConfig preemption;
 };
 
@@ -93,9 +99,11 @@ class DispatchService {
   // Applies edge changes to the overlay and tells every active planner of them; returns those missions.
   std::vector<MissionPtr> apply_changes(const std::vector<std::pair<EdgeId, planner::EdgeCondition>>& changes,
                                         const std::string& reason);
-  // Repairs those plans, one mission lock at a time, and publishes new routes; collects the write tickets.
+  // Repairs those plans, spread over the repair threads, one mission lock at a time each, and
+  // publishes new routes; collects the write tickets.
   CongestionResult repair_plans(const std::vector<MissionPtr>& missions, double now_s, std::chrono::steady_clock::time_point started,
                                 std::vector<std::shared_ptr<CommitTicket>>& durable);
+  void repair_one(Mission& m, double now_s, CongestionResult& result, std::vector<std::shared_ptr<CommitTicket>>& durable);
   // Under preemption_mutex_.
   void drain_preemption_events(Staged& staged);
   void emit(const std::string& kind, MissionId mission, const std::string& reason, double now_s);
@@ -145,6 +153,8 @@ class DispatchService {
   std::multimap<double, std::pair<EdgeId, std::uint64_t>> expiries_;
   std::unordered_map<EdgeId, std::uint64_t> latest_update_;
   std::uint64_t update_sequence_ = 0;
+
+  std::unique_ptr<boost::asio::thread_pool> repair_pool_;  // null with one repair thread
 
   mutable std::mutex listeners_mutex_;
   std::map<std::size_t, Listener> listeners_;

@@ -79,6 +79,8 @@ struct CongestionResult {
   // From the call's start to the last mission's repaired route: what a dispatcher waits, at most,
   // to see the effect of a congestion report (before its writes are durable).
   double replan_latency_s = 0;
+  // The longest single mission's D* Lite repair in this batch (its own lock held, costs read).
+  double slowest_replan_s = 0;
 };
 
 // What the service tells listeners (the WebSocket stream): kind and mission, with a JSON payload

@@ -137,7 +137,8 @@ Router::Router(DispatchService& service, TokenAuth auth, RouterConfig config, Cl
         return json_response(200, {{"edges_changed", res.edges_changed},
                                    {"missions_replanned", res.missions_replanned},
                                    {"routes_changed", res.routes_changed},
-                                   {"replan_latency_ms", res.replan_latency_s * 1e3}});
+                                   {"replan_latency_ms", res.replan_latency_s * 1e3},
+                                   {"slowest_replan_ms", res.slowest_replan_s * 1e3}});
       });
   add("POST", "/v1/signals/{id}/counts", kSensor, "Detector counts for a signal's approach",
       [this](const Principal&, const Match& m, const HttpRequest& r) {
