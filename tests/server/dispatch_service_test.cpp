@@ -255,6 +255,35 @@ TEST(DispatchService, ConcurrentReportsKeepEveryPlanOptimal) {
   EXPECT_GT(positions.load(), 300);
 }
 
+// The repair pool changes who repairs, not what: one thread and four give the same routes.
+TEST(DispatchService, RepairThreadsDoNotChangeTheRepairedRoutes) {
+  std::vector<std::vector<std::vector<EdgeId>>> routes;
+  for (int threads : {1, 4}) {
+    DispatchConfig config;
+    config.repair_threads = threads;
+    DispatchService service(grid(), config, nullptr, 0.0);
+    std::vector<MissionId> ids;
+    for (int i = 0; i < 6; ++i) ids.push_back(service.create_mission(request("amb-" + std::to_string(i)), 0.0).id);
+    std::vector<CongestionUpdate> updates;
+    for (EdgeId e : service.mission(ids[0]).route.edges) {
+      CongestionUpdate u;
+      u.edge = e;
+      u.factor = 4.0;
+      updates.push_back(u);
+    }
+    const CongestionResult r = service.report_congestion(updates, 1.0);
+    EXPECT_EQ(r.missions_replanned, ids.size());
+    EXPECT_EQ(r.routes_changed, ids.size());  // all six share the congested corner-to-corner route
+    EXPECT_GT(r.slowest_replan_s, 0.0);
+    routes.emplace_back();
+    for (MissionId id : ids) routes.back().push_back(service.mission(id).route.edges);
+  }
+  EXPECT_EQ(routes[0], routes[1]);
+  DispatchConfig bad;
+  bad.repair_threads = 0;
+  EXPECT_THROW(DispatchService(grid(), bad, nullptr, 0.0), std::invalid_argument);
+}
+
 // An expiry ends only the update it came with: a later closure without expiry stays in force.
 TEST(DispatchService, OldExpiryDoesNotReopenALaterClosure) {
   DispatchService service(grid(), {}, nullptr, 0.0);
