@@ -8,7 +8,9 @@
 #include <cmath>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <random>
+#include <sstream>
 #include <stdexcept>
 #include <thread>
 
@@ -32,7 +34,13 @@ class Client {
  public:
   explicit Client(unsigned short port) : stream_(ioc_) { stream_.connect(tcp::endpoint(net::ip::make_address("127.0.0.1"), port)); }
   std::pair<int, std::string> post(const std::string& target, const std::string& body) {
-    http::request<http::string_body> req{http::verb::post, target, 11};
+    return call(http::verb::post, target, body);
+  }
+  std::pair<int, std::string> get(const std::string& target) { return call(http::verb::get, target, ""); }
+
+ private:
+  std::pair<int, std::string> call(http::verb verb, const std::string& target, const std::string& body) {
+    http::request<http::string_body> req{verb, target, 11};
     req.set(http::field::host, "127.0.0.1");
     req.set(http::field::authorization, "Bearer " + kToken);
     req.set(http::field::content_type, "application/json");
@@ -45,7 +53,6 @@ class Client {
     return {res.result_int(), res.body()};
   }
 
- private:
   net::io_context ioc_;
   beast::tcp_stream stream_;
   beast::flat_buffer buffer_;
@@ -142,6 +149,36 @@ double percentile(std::vector<double> v, double q) {
   if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());
   return v[std::min(v.size() - 1, static_cast<std::size_t>(std::ceil(q * static_cast<double>(v.size()))) - 1)];
+}
+
+// A Prometheus histogram read back from the server's /metrics: how many samples, the share within
+// each bucket bound, and the smallest bound that holds 99 % of them (an upper bound of the p99).
+json histogram_from_metrics(const std::string& text, const std::string& name) {
+  std::vector<std::pair<double, double>> buckets;  // (le, cumulative count)
+  double count = 0;
+  std::istringstream in(text);
+  std::string line;
+  const std::string bucket_prefix = name + "_bucket{le=\"";
+  const std::string count_prefix = name + "_count{} ";
+  while (std::getline(in, line)) {
+    if (line.rfind(bucket_prefix, 0) == 0) {
+      const auto close = line.find('"', bucket_prefix.size());
+      const std::string le = line.substr(bucket_prefix.size(), close - bucket_prefix.size());
+      if (le != "+Inf") buckets.emplace_back(std::stod(le), std::stod(line.substr(line.rfind(' ') + 1)));
+    } else if (line.rfind(count_prefix, 0) == 0) {
+      count = std::stod(line.substr(count_prefix.size()));
+    }
+  }
+  json out{{"count", static_cast<std::uint64_t>(count)}};
+  json within = json::array();
+  std::optional<double> p99_bound;
+  for (const auto& [le, cumulative] : buckets) {
+    if (count > 0) within.push_back({{"le_ms", le * 1e3}, {"share", cumulative / count}});
+    if (!p99_bound && count > 0 && cumulative >= 0.99 * count) p99_bound = le * 1e3;
+  }
+  out["share_within"] = std::move(within);
+  out["p99_at_most_ms"] = p99_bound ? json(*p99_bound) : json(nullptr);
+  return out;
 }
 
 }  // namespace
@@ -252,6 +289,7 @@ json run_serve_bench(const maps::RoadGraph& graph, const ServeBenchConfig& c) {
   const std::vector<double>& congestion_ms = sensor.latencies_ms();
 
   const auto commits = service.commit_stats();
+  const auto [metrics_status, metrics_text] = Client(port).get("/metrics");
   http.stop();
   server_thread.join();
   std::filesystem::remove(db);
@@ -273,6 +311,9 @@ json run_serve_bench(const maps::RoadGraph& graph, const ServeBenchConfig& c) {
   out["congestion"]["replan_latency_ms"]["p99_ms"] = percentile(replan_latency_ms, 0.99);
   out["congestion"]["slowest_mission_replan_ms"] = latency_json(slowest_replan_ms);
   out["congestion"]["slowest_mission_replan_ms"]["p99_ms"] = percentile(slowest_replan_ms, 0.99);
+  // Every single mission repair the congestion caused, from the server's own histogram.
+  out["congestion"]["mission_replans"] =
+      histogram_from_metrics(metrics_status == 200 ? metrics_text : "", "corridor_congestion_mission_replan_seconds");
   out["congestion"]["edges_per_s"] = static_cast<double>(congestion_ms.size()) *
                                      (c.congestion_edges_per_s / c.congestion_requests_per_s) / elapsed;
   out["errors"] = errors;

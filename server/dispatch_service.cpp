@@ -547,8 +547,9 @@ void DispatchService::repair_one(Mission& m, double now_s, CongestionResult& res
   const std::vector<EdgeId> before = m.route.edges;
   const auto started = std::chrono::steady_clock::now();
   const std::optional<std::string> reason = repair(m, nullptr);
-  result.slowest_replan_s =
-      std::max(result.slowest_replan_s, std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+  const double took_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  result.slowest_replan_s = std::max(result.slowest_replan_s, took_s);
+  result.mission_replan_s.push_back(took_s);
   if (!reason) return;  // a position report repaired it in the meantime
   Staged staged;
   if (m.route.edges != before) {
@@ -584,6 +585,7 @@ CongestionResult DispatchService::repair_plans(const std::vector<MissionPtr>& mi
     result.missions_replanned += mine.missions_replanned;
     result.routes_changed += mine.routes_changed;
     result.slowest_replan_s = std::max(result.slowest_replan_s, mine.slowest_replan_s);
+    result.mission_replan_s.insert(result.mission_replan_s.end(), mine.mission_replan_s.begin(), mine.mission_replan_s.end());
     durable.insert(durable.end(), tickets.begin(), tickets.end());
   };
   const std::size_t helpers =

@@ -81,6 +81,8 @@ struct CongestionResult {
   double replan_latency_s = 0;
   // The longest single mission's D* Lite repair in this batch (its own lock held, costs read).
   double slowest_replan_s = 0;
+  // Each repaired mission's D* Lite repair time, in no particular order: the per-replan latency.
+  std::vector<double> mission_replan_s;
 };
 
 // What the service tells listeners (the WebSocket stream): kind and mission, with a JSON payload

@@ -134,6 +134,7 @@ Router::Router(DispatchService& service, TokenAuth auth, RouterConfig config, Cl
         const CongestionResult res = service_.report_congestion(congestion_from_json(parse_body(r.body)), clock_());
         metrics_.observe("congestion_replan_seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
         metrics_.count("replans_total", static_cast<double>(res.missions_replanned));
+        for (double s : res.mission_replan_s) metrics_.observe("congestion_mission_replan_seconds", s);
         return json_response(200, {{"edges_changed", res.edges_changed},
                                    {"missions_replanned", res.missions_replanned},
                                    {"routes_changed", res.routes_changed},

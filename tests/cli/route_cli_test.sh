@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# End-to-end tests of `corridor route`, `corridor map` and `corridor bench replan` as a user runs them.
+# End-to-end tests of `corridor route`, `corridor map`, `corridor bench replan` and `bench serve` as a user runs them.
 # Usage: route_cli_test.sh CORRIDOR_BINARY SHARED_DATA_DIR
 set -euo pipefail
 corridor=$1
@@ -148,6 +148,24 @@ assert t["low"][t["movements"].index("N->S")][t["phases"].index("3+8")] == "4+8"
 PY
 then pass; else fail "preemption tables --json"; fi
 "$corridor" preemption tables | grep -q "agree in 12 of 96 cells" && pass || fail "preemption tables text"
+
+# 7. The server load benchmark: a short run on the embedded map keeps its keys, answers every
+# request, and reads back one per-mission repair sample for each congestion-triggered replan.
+"$corridor" bench serve --seconds 1.5 --vehicles 20 --missions 10 --congestion-edges-per-s 400 > "$work/serve.json" 2> /dev/null
+if python3 - "$work/serve.json" <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert j["errors"] == 0, j["errors"]
+p, c = j["positions"], j["congestion"]
+assert p["count"] > 0 and p["per_s"] > 0 and 0 <= p["p50_ms"] <= p["p99_ms"] <= p["max_ms"], p
+assert c["count"] > 0 and c["replan_latency_ms"]["count"] == c["count"], c
+r = c["mission_replans"]
+assert r["count"] > 0, r
+shares = [b["share"] for b in r["share_within"]]
+assert shares == sorted(shares) and shares[-1] == 1.0, shares
+assert r["p99_at_most_ms"] is not None and r["p99_at_most_ms"] <= 1000, r
+PY
+then pass; else fail "bench serve output: $(head -c 400 "$work/serve.json")"; fi
 
 echo "$passed passed, $failed failed"
 ((failed == 0))

@@ -275,6 +275,8 @@ TEST(DispatchService, RepairThreadsDoNotChangeTheRepairedRoutes) {
     EXPECT_EQ(r.missions_replanned, ids.size());
     EXPECT_EQ(r.routes_changed, ids.size());  // all six share the congested corner-to-corner route
     EXPECT_GT(r.slowest_replan_s, 0.0);
+    ASSERT_EQ(r.mission_replan_s.size(), r.missions_replanned);
+    EXPECT_EQ(*std::max_element(r.mission_replan_s.begin(), r.mission_replan_s.end()), r.slowest_replan_s);
     routes.emplace_back();
     for (MissionId id : ids) routes.back().push_back(service.mission(id).route.edges);
   }

@@ -158,6 +158,26 @@ TEST(Router, SignalsMapHealthAndMetrics) {
       << metrics.body;
 }
 
+// Every mission repair a congestion report triggers is one sample of the per-replan histogram, so
+// its count matches what the answers said was replanned.
+TEST(Router, CongestionRepairsAreTimedPerMissionInTheMetrics) {
+  Rig rig;
+  const json m = body(rig.call("POST", "/v1/missions", kDispatcher, mission_body("amb-1")));
+  ASSERT_EQ(rig.call("POST", "/v1/missions", kDispatcher, mission_body("amb-2")).status, 201);
+  std::size_t replanned = 0;
+  for (const auto& edge : m["route"]["properties"]["edges"]) {
+    const json answer = body(rig.call("POST", "/v1/congestion", kSensor,
+                                      R"({"updates":[{"edge":)" + edge.dump() + R"(,"factor":3}]})"));
+    replanned += answer["missions_replanned"].get<std::size_t>();
+  }
+  ASSERT_GE(replanned, 2u);
+  const std::string metrics = rig.call("GET", "/metrics").body;
+  EXPECT_NE(metrics.find("corridor_congestion_mission_replan_seconds_count{} " + std::to_string(replanned) + "\n"),
+            std::string::npos)
+      << metrics;
+  EXPECT_NE(metrics.find("corridor_replans_total " + std::to_string(replanned) + "\n"), std::string::npos) << metrics;
+}
+
 // Per-token token bucket: a burst is allowed, then 429 until time refills it; other tokens are
 // not affected.
 TEST(Router, APositionIsAnsweredOnlyOnceStoredAndA503WhenItCannotBe) {
