@@ -19,7 +19,10 @@ DStarLite::DStarLite(const TravelCost& cost, std::vector<EdgePoint> starts, std:
 
 DStarLite::Key DStarLite::calculate_key(Vertex s) const {
   const double m = std::min(g_[s.index()], rhs_[s.index()]);
-  return {add_cost(add_cost(m, space_.heuristic_s(space_.start(), s)), km_), m};
+  // last_start_pos_ is the start's position (move_start keeps it so): h(start, s) without the
+  // start's lookup, and 0 for the start itself, which the stopping test asks for every iteration.
+  const double h = s == space_.start() ? 0.0 : space_.cost().heuristic_s(last_start_pos_, space_.position(s));
+  return {add_cost(add_cost(m, h), km_), m};
 }
 
 double DStarLite::min_successor_cost(Vertex u) const {
@@ -108,11 +111,13 @@ ReplanStats DStarLite::replan() {
       const double g_old = g_[u.index()];
       g_[u.index()] = kInfCost;
       space_.for_each_predecessor(u, [&](Vertex s, double c) {
+        // Only a predecessor that u supported changes. The others keep g, rhs and so their place
+        // in (or out of) the queue; a key left stale is a lower bound, which the rekey step handles.
         if (s != goal && rhs_[s.index()] == add_cost(c, g_old)) {
           rhs_[s.index()] = min_successor_cost(s);
           ++stats.updated;
+          update_vertex(s);
         }
-        update_vertex(s);
       });
       // rhs(u) depends only on u's successors, which did not change: it stays valid.
       update_vertex(u);

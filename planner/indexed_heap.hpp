@@ -1,5 +1,6 @@
-// A binary min-heap over dense vertex ids with decrease-, increase-key and removal, as D* Lite's
-// open list needs. Keys are compared with operator<.
+// A 4-ary min-heap over dense vertex ids with decrease-, increase-key and removal, as D* Lite's
+// open list needs. Keys are compared with operator<. Four children per node: a shallower heap, and
+// the children of one node share a cache line or two.
 #pragma once
 
 #include <cstdint>
@@ -61,6 +62,8 @@ class IndexedHeap {
   }
 
  private:
+  static constexpr std::uint32_t kArity = 4;
+
   struct Entry {
     Key key;
     std::uint32_t id;
@@ -73,7 +76,7 @@ class IndexedHeap {
   void sift_up(std::uint32_t i) {
     Entry e = heap_[i];
     while (i > 0) {
-      const std::uint32_t parent = (i - 1) / 2;
+      const std::uint32_t parent = (i - 1) / kArity;
       if (!(e.key < heap_[parent].key)) break;
       place(i, heap_[parent]);
       i = parent;
@@ -84,9 +87,13 @@ class IndexedHeap {
     Entry e = heap_[i];
     const auto n = static_cast<std::uint32_t>(heap_.size());
     while (true) {
-      std::uint32_t child = 2 * i + 1;
-      if (child >= n) break;
-      if (child + 1 < n && heap_[child + 1].key < heap_[child].key) ++child;
+      const std::uint32_t first = kArity * i + 1;
+      if (first >= n) break;
+      std::uint32_t child = first;
+      const std::uint32_t end = first + kArity < n ? first + kArity : n;
+      for (std::uint32_t c = first + 1; c < end; ++c) {
+        if (heap_[c].key < heap_[child].key) child = c;
+      }
       if (!(heap_[child].key < e.key)) break;
       place(i, heap_[child]);
       i = child;
