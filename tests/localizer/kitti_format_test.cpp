@@ -12,12 +12,26 @@ namespace corridor::localizer {
 namespace {
 namespace fs = std::filesystem;
 
-fs::path temp_dir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("corridor_kitti_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+// A fresh directory for one test, removed with everything in it when the test ends.
+class TempDir {
+ public:
+  explicit TempDir(const std::string& name)
+      : path_(fs::temp_directory_path() / ("corridor_kitti_" + name + "_" + std::to_string(::getpid()))) {
+    fs::remove_all(path_);
+    fs::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ignored;
+    fs::remove_all(path_, ignored);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  [[nodiscard]] const fs::path& path() const { return path_; }
+  fs::path operator/(const char* file) const { return path_ / file; }
+
+ private:
+  fs::path path_;
+};
 
 TEST(StereoCamera, TriangulatesDepthFromDisparity) {
   const StereoCamera c{700, 700, 320, 240, 0.3};
@@ -30,7 +44,7 @@ TEST(StereoCamera, TriangulatesDepthFromDisparity) {
 }
 
 TEST(StereoCamera, CalibrationRoundTripsThroughKittiFormat) {
-  const auto d = temp_dir("calib");
+  const TempDir d("calib");
   const StereoCamera c{718.856, 718.856, 607.1928, 185.2157, 0.5371};
   write_kitti_calibration(d / "calib.txt", c);
   const auto r = read_kitti_calibration(d / "calib.txt");
@@ -48,7 +62,7 @@ TEST(StereoCamera, ReadsTheSharedKittiCalibration) {
 }
 
 TEST(StereoCamera, RejectsCalibrationWithoutBaseline) {
-  const auto d = temp_dir("badcalib");
+  const TempDir d("badcalib");
   std::ofstream(d / "calib.txt") << "P0: 700 0 320 0 0 700 240 0 0 0 1 0\nP1: 700 0 320 0 0 700 240 0 0 0 1 0\n";
   EXPECT_THROW(read_kitti_calibration(d / "calib.txt"), SequenceError);
   std::ofstream(d / "short.txt") << "P0: 700 0 320\n";
@@ -57,7 +71,7 @@ TEST(StereoCamera, RejectsCalibrationWithoutBaseline) {
 }
 
 TEST(KittiPoses, RoundTripKeepsEveryEntry) {
-  const auto d = temp_dir("poses");
+  const TempDir d("poses");
   std::vector<Pose> poses(3, Pose::Identity());
   poses[1].translation() << 1.5, -0.25, 12.0;
   poses[2].linear() = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY()).toRotationMatrix();
@@ -68,23 +82,23 @@ TEST(KittiPoses, RoundTripKeepsEveryEntry) {
 }
 
 TEST(KittiPoses, RejectsAShortRow) {
-  const auto d = temp_dir("badposes");
+  const TempDir d("badposes");
   std::ofstream(d / "p.txt") << "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 0 0 1\n";
   EXPECT_THROW(read_kitti_poses(d / "p.txt"), SequenceError);
 }
 
 TEST(StereoSequence, ExplainsMissingPartsAndMismatchedCounts) {
   EXPECT_THROW(open_stereo_sequence("/nonexistent/seq"), SequenceError);
-  const auto d = temp_dir("seq");
+  const TempDir d("seq");
   write_kitti_calibration(d / "calib.txt", {700, 700, 320, 240, 0.3});
-  EXPECT_THROW(open_stereo_sequence(d), SequenceError);  // no image_0/
+  EXPECT_THROW(open_stereo_sequence(d.path()), SequenceError);  // no image_0/
   fs::create_directories(d / "image_0");
   fs::create_directories(d / "image_1");
   std::ofstream(d / "image_0/000000.png") << "x";
   std::ofstream(d / "image_0/000001.png") << "x";
   std::ofstream(d / "image_1/000000.png") << "x";
   try {
-    open_stereo_sequence(d);
+    open_stereo_sequence(d.path());
     FAIL() << "mismatched counts accepted";
   } catch (const SequenceError& e) {
     EXPECT_NE(std::string(e.what()).find("image_1/ has 1"), std::string::npos) << e.what();
