@@ -123,8 +123,8 @@ void EventHub::publish(const std::string& text, MissionId mission) {
 
 class HttpSession : public std::enable_shared_from_this<HttpSession> {
  public:
-  HttpSession(tcp::socket&& socket, Router& router, EventHub& hub, const ServerLimits& limits)
-      : stream_(std::move(socket)), router_(router), hub_(hub), limits_(limits) {}
+  HttpSession(tcp::socket&& socket, Router& router, EventHub& hub, const ServerLimits& limits, net::thread_pool& workers)
+      : stream_(std::move(socket)), router_(router), hub_(hub), limits_(limits), workers_(workers) {}
 
   void run() { net::dispatch(stream_.get_executor(), beast::bind_front_handler(&HttpSession::read, shared_from_this())); }
 
@@ -161,15 +161,21 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
       std::make_shared<WsSession>(stream_.release_socket(), hub_, filter, limits_.max_queued_events)->run(std::move(req));
       return;
     }
-    // The answer may come from the commit thread once the request's writes are durable; it is
-    // written from this connection's strand.
-    router_.handle_async({std::string(req.method_string()), target, std::string(req[http::field::authorization]),
-                          std::move(req.body())},
-                         [self = shared_from_this(), keep_alive = req.keep_alive()](HttpResponse r) {
-                           net::dispatch(self->stream_.get_executor(), [self, keep_alive, r = std::move(r)]() mutable {
-                             self->respond(r.status, r.content_type, std::move(r.body), keep_alive);
-                           });
-                         });
+    // The answer may come from the commit thread once the request's writes are durable, or from a
+    // worker; it is written from this connection's strand.
+    HttpRequest request{std::string(req.method_string()), target, std::string(req[http::field::authorization]),
+                        std::move(req.body())};
+    auto reply = [self = shared_from_this(), keep_alive = req.keep_alive()](HttpResponse r) {
+      net::dispatch(self->stream_.get_executor(), [self, keep_alive, r = std::move(r)]() mutable {
+        self->respond(r.status, r.content_type, std::move(r.body), keep_alive);
+      });
+    };
+    if (!router_.blocks(request)) return router_.handle_async(request, std::move(reply));
+    // Waits for storage or plans a route: on a worker, so that this I/O thread goes on serving
+    // other connections' position reports meanwhile.
+    net::post(workers_, [&router = router_, request = std::move(request), reply = std::move(reply)]() mutable {
+      router.handle_async(request, std::move(reply));
+    });
   }
 
   void reply_error(int status, const std::string& code, const std::string& message, bool keep_alive) {
@@ -205,6 +211,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   Router& router_;
   EventHub& hub_;
   const ServerLimits& limits_;
+  net::thread_pool& workers_;
 };
 
 }  // namespace
@@ -218,7 +225,7 @@ struct HttpServer::Impl {
     acceptor.async_accept(net::make_strand(ioc), [this](beast::error_code ec, tcp::socket socket) {
       if (!acceptor.is_open() || ec == net::error::operation_aborted) return;  // stopping
       if (!ec) {
-        std::make_shared<HttpSession>(std::move(socket), router, hub, limits)->run();
+        std::make_shared<HttpSession>(std::move(socket), router, hub, limits, workers)->run();
         accept();
         return;
       }
@@ -234,11 +241,14 @@ struct HttpServer::Impl {
     ticker.expires_after(std::chrono::seconds(1));
     ticker.async_wait([this](beast::error_code ec) {
       if (ec) return;
-      try {
-        service.tick(wall_clock_s());
-      } catch (const std::exception& e) {
-        spdlog::error("event=tick_failed error=\"{}\"", e.what());
-      }
+      // Expiries replan missions and store their writes: a worker's job, like a congestion report.
+      net::post(workers, [this] {
+        try {
+          service.tick(wall_clock_s());
+        } catch (const std::exception& e) {
+          spdlog::error("event=tick_failed error=\"{}\"", e.what());
+        }
+      });
       tick();
     });
   }
@@ -254,6 +264,9 @@ struct HttpServer::Impl {
   net::steady_timer accept_retry;
   EventHub hub;
   std::size_t subscription = 0;
+  // Runs the requests that block (Router::blocks) and the ticks. Two, so that a mission can be
+  // created while a congestion batch is repaired; the service serializes what must be serial.
+  net::thread_pool workers{2};
 };
 
 HttpServer::HttpServer(Router& router, DispatchService& service, ServerLimits limits, const std::string& address,
@@ -272,6 +285,9 @@ HttpServer::HttpServer(Router& router, DispatchService& service, ServerLimits li
 
 HttpServer::~HttpServer() {
   stop();
+  // Requests already handed to a worker finish (their writes are stored; the answer has no
+  // connection left to go to), and no tick runs after this.
+  impl_->workers.join();
   // Answers still waiting for their commit hand their response to a session's executor: let them
   // do that while the io_context is still alive (stopped, it only queues and then drops them).
   try {

@@ -18,13 +18,16 @@ constexpr std::uint8_t kRead = static_cast<std::uint8_t>(Role::viewer) | static_
 constexpr std::uint8_t kDispatch = static_cast<std::uint8_t>(Role::dispatcher);
 constexpr std::uint8_t kSensor = static_cast<std::uint8_t>(Role::sensor);
 constexpr std::uint8_t kVehicle = static_cast<std::uint8_t>(Role::vehicle);
+// Routes that wait for their writes to be durable, or plan whole routes, before they answer.
+constexpr bool kBlocking = true;
 
-std::vector<std::string> split_path(const std::string& path) {
+std::vector<std::string> split_path(std::string_view path) {
   std::vector<std::string> parts;
-  std::string part;
-  std::istringstream in(path);
-  while (std::getline(in, part, '/')) {
-    if (!part.empty()) parts.push_back(part);
+  std::size_t begin = 0;
+  while (begin <= path.size()) {
+    const std::size_t end = std::min(path.find('/', begin), path.size());
+    if (end > begin) parts.emplace_back(path.substr(begin, end - begin));
+    begin = end + 1;
   }
   return parts;
 }
@@ -90,7 +93,7 @@ Router::Router(DispatchService& service, TokenAuth auth, RouterConfig config, Cl
     const MissionView m = service_.create_mission(mission_request_from_json(parse_body(r.body)), clock_());
     metrics_.observe("plan_seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
     return json_response(201, mission_to_json(service_.graph(), m));
-  });
+  }, kBlocking);
   add("GET", "/v1/missions", kRead, "List missions (?state=active|completed|cancelled)",
       [this](const Principal&, const Match& m, const HttpRequest&) {
         std::optional<MissionState> state;
@@ -108,7 +111,7 @@ Router::Router(DispatchService& service, TokenAuth auth, RouterConfig config, Cl
   add("POST", "/v1/missions/{id}/cancel", kDispatch, "Cancel a mission",
       [this](const Principal&, const Match& m, const HttpRequest&) {
         return json_response(200, mission_to_json(service_.graph(), service_.cancel_mission(parse_id(m.params[0], "mission id"), clock_())));
-      });
+      }, kBlocking);
   add("POST", "/v1/vehicles/{id}/position", kVehicle | kDispatch, "Report a vehicle position",
       [this](const Principal& who, const Match& m, const HttpRequest& r) {
         const std::string& vehicle = m.params[0];
@@ -140,7 +143,7 @@ Router::Router(DispatchService& service, TokenAuth auth, RouterConfig config, Cl
                                    {"routes_changed", res.routes_changed},
                                    {"replan_latency_ms", res.replan_latency_s * 1e3},
                                    {"slowest_replan_ms", res.slowest_replan_s * 1e3}});
-      });
+      }, kBlocking);
   add("POST", "/v1/signals/{id}/counts", kSensor, "Detector counts for a signal's approach",
       [this](const Principal&, const Match& m, const HttpRequest& r) {
         const auto id = parse_id(m.params[0], "signal id");
@@ -183,9 +186,11 @@ Router::Router(DispatchService& service, TokenAuth auth, RouterConfig config, Cl
 
 Router::~Router() { service_.unsubscribe(subscription_); }
 
-void Router::add(std::string method, std::string pattern, std::uint8_t roles, std::string summary, Handler handler) {
+void Router::add(std::string method, std::string pattern, std::uint8_t roles, std::string summary, Handler handler,
+                 bool blocking) {
   auto segments = split_path(pattern);
-  routes_.push_back({std::move(method), std::move(pattern), std::move(segments), roles, std::move(summary), std::move(handler)});
+  routes_.push_back(
+      {std::move(method), std::move(pattern), std::move(segments), roles, std::move(summary), std::move(handler), blocking});
 }
 
 HttpResponse Router::json_response(int status, const json& body) const {
@@ -244,6 +249,38 @@ void Router::handle_async(const HttpRequest& request, std::function<void(HttpRes
   });
 }
 
+const Router::Route* Router::match_route(const std::string& method, std::string_view path, std::vector<std::string>& params,
+                                         bool& path_known) const {
+  const auto parts = split_path(path);
+  for (const Route& r : routes_) {
+    const auto& pattern = r.segments;
+    if (pattern.size() != parts.size()) continue;
+    bool ok = true;
+    for (std::size_t i = 0; i < parts.size() && ok; ++i) ok = pattern[i].front() == '{' || pattern[i] == parts[i];
+    if (!ok) continue;
+    path_known = true;
+    if (r.method != method) continue;
+    params.clear();
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+      if (pattern[i].front() == '{') params.push_back(parts[i]);
+    }
+    return &r;
+  }
+  return nullptr;
+}
+
+bool Router::blocks(const HttpRequest& request) const noexcept {
+  try {
+    const std::string_view target(request.target);
+    std::vector<std::string> params;
+    bool path_known = false;
+    const Route* r = match_route(request.method, target.substr(0, target.find('?')), params, path_known);
+    return r != nullptr && r->blocking;
+  } catch (...) {
+    return false;  // out of memory: answer() will say so
+  }
+}
+
 HttpResponse Router::answer(const HttpRequest& request, std::string& route_name) noexcept {
   HttpResponse response;
   try {
@@ -258,29 +295,8 @@ HttpResponse Router::answer(const HttpRequest& request, std::string& route_name)
         match.query[pair.substr(0, eq)] = eq == std::string::npos ? "" : pair.substr(eq + 1);
       }
     }
-    const auto parts = split_path(path);
-    const Route* found = nullptr;
     bool path_known = false;
-    for (const Route& r : routes_) {
-      const auto& pattern = r.segments;
-      if (pattern.size() != parts.size()) continue;
-      std::vector<std::string> params;
-      bool ok = true;
-      for (std::size_t i = 0; i < parts.size() && ok; ++i) {
-        if (pattern[i].front() == '{') {
-          params.push_back(parts[i]);
-        } else {
-          ok = pattern[i] == parts[i];
-        }
-      }
-      if (!ok) continue;
-      path_known = true;
-      if (r.method == request.method) {
-        found = &r;
-        match.params = std::move(params);
-        break;
-      }
-    }
+    const Route* found = match_route(request.method, path, match.params, path_known);
     if (found == nullptr) {
       throw path_known ? ApiError(405, "method_not_allowed", request.method + " is not allowed on " + path)
                        : not_found("no such endpoint: " + path.substr(0, 200));

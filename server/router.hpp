@@ -8,6 +8,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <unordered_map>
 #include <vector>
 
@@ -54,6 +55,10 @@ class Router {
   // Same answer, delivered through `reply` once durable: at once on the caller's thread, or later
   // on the commit thread. Never throws.
   void handle_async(const HttpRequest& request, std::function<void(HttpResponse)> reply) noexcept;
+  // True for the routes that wait for their writes to be durable, or plan a whole route, before
+  // they answer (creating and cancelling missions, congestion): a transport runs those off its
+  // I/O threads, so that one of them cannot hold up the position reports behind it.
+  [[nodiscard]] bool blocks(const HttpRequest& request) const noexcept;
   // For the WebSocket upgrade: the principal if it may read the stream.
   [[nodiscard]] std::optional<Principal> authorize_stream(const std::string& authorization) const;
   [[nodiscard]] nlohmann::json openapi() const;
@@ -72,9 +77,15 @@ class Router {
     std::uint8_t roles;   // any of these may call; 0 = no token needed
     std::string summary;
     Handler handler;
+    bool blocking;  // see blocks()
   };
 
-  void add(std::string method, std::string pattern, std::uint8_t roles, std::string summary, Handler handler);
+  void add(std::string method, std::string pattern, std::uint8_t roles, std::string summary, Handler handler,
+           bool blocking = false);
+  // The route for this method and path (its path parameters in `params`), or null; `path_known`
+  // says whether the path exists for another method.
+  const Route* match_route(const std::string& method, std::string_view path, std::vector<std::string>& params,
+                           bool& path_known) const;
   bool take_token(const std::string& key, double now_s);
   HttpResponse json_response(int status, const nlohmann::json& body) const;
   // The answer, possibly still waiting on after_commit; records nothing in the metrics.

@@ -158,6 +158,22 @@ TEST(Router, SignalsMapHealthAndMetrics) {
       << metrics.body;
 }
 
+// The transport runs these off its I/O threads: they wait for storage or plan a whole route.
+TEST(Router, OnlyRoutesThatWaitForStorageOrPlanningBlock) {
+  Rig rig;
+  auto blocks = [&](const std::string& method, const std::string& target) { return rig.router.blocks({method, target, "", ""}); };
+  EXPECT_TRUE(blocks("POST", "/v1/missions"));
+  EXPECT_TRUE(blocks("POST", "/v1/missions?dry=1"));
+  EXPECT_TRUE(blocks("POST", "/v1/missions/7/cancel"));
+  EXPECT_TRUE(blocks("POST", "/v1/congestion"));
+  EXPECT_FALSE(blocks("POST", "/v1/vehicles/amb-1/position"));  // answered once durable, without waiting
+  EXPECT_FALSE(blocks("GET", "/v1/missions"));
+  EXPECT_FALSE(blocks("GET", "/v1/missions/7"));
+  EXPECT_FALSE(blocks("GET", "/v1/congestion"));  // no such route: answered inline with 405
+  EXPECT_FALSE(blocks("POST", "/no/such/path"));
+  EXPECT_FALSE(blocks("POST", ""));
+}
+
 // Every mission repair a congestion report triggers is one sample of the per-replan histogram, so
 // its count matches what the answers said was replanned.
 TEST(Router, CongestionRepairsAreTimedPerMissionInTheMetrics) {
