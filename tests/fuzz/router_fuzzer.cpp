@@ -47,6 +47,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   req.target = kTargets[(selector >> 1) % (sizeof kTargets / sizeof kTargets[0])];
   req.authorization = (data[1] & 1) != 0 ? "Bearer fuzz-token-0123456789" : "Bearer nope";
   req.body.assign(reinterpret_cast<const char*>(data + 2), size - 2);
+  if ((data[1] & 2) != 0) {
+    // The target comes from the input as well: its first line, the rest is the body.
+    const auto newline = req.body.find('\n');
+    req.target = req.body.substr(0, newline);
+    req.body = newline == std::string::npos ? "" : req.body.substr(newline + 1);
+  }
+  (void)t.router.blocks(req);
   t.now += 0.5;
   const server::HttpResponse r = t.router.handle(req);
   if (r.status >= 500) std::abort();
