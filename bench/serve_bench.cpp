@@ -151,15 +151,16 @@ double percentile(std::vector<double> v, double q) {
   return v[std::min(v.size() - 1, static_cast<std::size_t>(std::ceil(q * static_cast<double>(v.size()))) - 1)];
 }
 
-// A Prometheus histogram read back from the server's /metrics: how many samples, the share within
-// each bucket bound, and the smallest bound that holds 99 % of them (an upper bound of the p99).
-json histogram_from_metrics(const std::string& text, const std::string& name) {
+// A Prometheus histogram (with these labels) read back from the server's /metrics: how many
+// samples, the share within each bucket bound, and the smallest bound that holds 99 % of them (an
+// upper bound of the p99).
+json histogram_from_metrics(const std::string& text, const std::string& name, const std::string& labels = "") {
   std::vector<std::pair<double, double>> buckets;  // (le, cumulative count)
   double count = 0;
   std::istringstream in(text);
   std::string line;
-  const std::string bucket_prefix = name + "_bucket{le=\"";
-  const std::string count_prefix = name + "_count{} ";
+  const std::string bucket_prefix = name + "_bucket{" + labels + (labels.empty() ? "" : ",") + "le=\"";
+  const std::string count_prefix = name + "_count{" + labels + "} ";
   while (std::getline(in, line)) {
     if (line.rfind(bucket_prefix, 0) == 0) {
       const auto close = line.find('"', bucket_prefix.size());
@@ -314,6 +315,11 @@ json run_serve_bench(const maps::RoadGraph& graph, const ServeBenchConfig& c) {
   // Every single mission repair the congestion caused, from the server's own histogram.
   out["congestion"]["mission_replans"] =
       histogram_from_metrics(metrics_status == 200 ? metrics_text : "", "corridor_congestion_mission_replan_seconds");
+  // From the request's handling to its answer (its commit included), without the time it spent
+  // in socket buffers or waiting for an I/O thread: what is the server's own, and what is queueing.
+  out["positions"]["server_side"] =
+      histogram_from_metrics(metrics_status == 200 ? metrics_text : "", "corridor_http_request_duration_seconds",
+                             "route=\"POST /v1/vehicles/{id}/position\"");
   out["congestion"]["edges_per_s"] = static_cast<double>(congestion_ms.size()) *
                                      (c.congestion_edges_per_s / c.congestion_requests_per_s) / elapsed;
   out["errors"] = errors;

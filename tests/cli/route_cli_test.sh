@@ -159,6 +159,8 @@ assert j["errors"] == 0, j["errors"]
 p, c = j["positions"], j["congestion"]
 assert p["count"] > 0 and p["per_s"] > 0 and 0 <= p["p50_ms"] <= p["p99_ms"] <= p["max_ms"], p
 assert c["count"] > 0 and c["replan_latency_ms"]["count"] == c["count"], c
+s = p["server_side"]
+assert s["count"] == p["count"], (s["count"], p["count"])  # every answered position, timed by the server too
 r = c["mission_replans"]
 assert r["count"] > 0, r
 shares = [b["share"] for b in r["share_within"]]
