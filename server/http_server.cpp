@@ -4,6 +4,7 @@
 
 #include <boost/asio.hpp>
 #include <boost/beast.hpp>
+#include <atomic>
 #include <chrono>
 #include <deque>
 #include <mutex>
@@ -242,13 +243,18 @@ struct HttpServer::Impl {
     ticker.async_wait([this](beast::error_code ec) {
       if (ec) return;
       // Expiries replan missions and store their writes: a worker's job, like a congestion report.
-      net::post(workers, [this] {
-        try {
-          service.tick(wall_clock_s());
-        } catch (const std::exception& e) {
-          spdlog::error("event=tick_failed error=\"{}\"", e.what());
-        }
-      });
+      // A tick still running (a large expiry batch) is not joined by another: ticks must not take
+      // both workers from the requests.
+      if (!ticking.exchange(true)) {
+        net::post(workers, [this] {
+          try {
+            service.tick(wall_clock_s());
+          } catch (const std::exception& e) {
+            spdlog::error("event=tick_failed error=\"{}\"", e.what());
+          }
+          ticking = false;
+        });
+      }
       tick();
     });
   }
@@ -267,6 +273,7 @@ struct HttpServer::Impl {
   // Runs the requests that block (Router::blocks) and the ticks. Two, so that a mission can be
   // created while a congestion batch is repaired; the service serializes what must be serial.
   net::thread_pool workers{2};
+  std::atomic<bool> ticking{false};
 };
 
 HttpServer::HttpServer(Router& router, DispatchService& service, ServerLimits limits, const std::string& address,
