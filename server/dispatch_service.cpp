@@ -1,18 +1,15 @@
 #include "server/dispatch_service.hpp"
 
-#include <boost/asio/post.hpp>
 #include <boost/asio/thread_pool.hpp>
 #include <spdlog/spdlog.h>
 
-#include <atomic>
 #include <cmath>
-#include <exception>
-#include <latch>
 
 #include "maps/errors.hpp"
 #include "maps/intersection_geometry.hpp"
 #include "planner/route_geojson.hpp"
 #include "planner/snap_points.hpp"
+#include "server/dispatch_mission.hpp"
 
 namespace corridor::server {
 
@@ -31,26 +28,6 @@ std::optional<MissionState> mission_state_from(const std::string& s) {
   }
   return std::nullopt;
 }
-
-struct DispatchService::Mission {
-  // Confines everything below but the pending changes: one request works on a mission at a time.
-  mutable std::mutex mutex;
-  MissionRow row;
-  std::optional<maps::LatLon> last_position;
-  maps::Point2 destination_local;
-  std::unique_ptr<planner::TravelCost> cost;
-  std::unique_ptr<planner::DStarLite> planner;
-  planner::Route route;
-  std::uint32_t revision = 0;
-  std::vector<preemption::ScheduleEntry> final_schedule;  // kept when the engine forgets the mission
-
-  // Edges whose cost changed since the planner last heard, and the reason to give if the repaired
-  // route differs. Appended under the overlay's exclusive lock, taken under its shared lock, so a
-  // repair sees exactly the costs it was told of.
-  std::mutex pending_mutex;
-  std::vector<EdgeId> pending_edges;
-  std::optional<std::string> pending_reason;
-};
 
 namespace {
 
@@ -75,7 +52,6 @@ double angle_between_deg(double a, double b) {
 }
 
 }  // namespace
-
 
 DispatchService::DispatchService(const maps::RoadGraph& graph, DispatchConfig config, Store* store, double now_s)
     : DispatchService(graph, maps::default_signal_plans(graph), config, store, now_s) {}
@@ -107,6 +83,10 @@ DispatchService::DispatchService(const maps::RoadGraph& graph, std::unordered_ma
 // Queued writes hold copies of what they store, so the queue may drain after the rest is gone.
 DispatchService::~DispatchService() {
   if (repair_pool_) repair_pool_->join();
+}
+
+void DispatchService::stage(Staged& staged, CommitQueue::Write write) const {
+  if (commits_) staged.push_back(std::move(write));
 }
 
 std::shared_ptr<CommitTicket> DispatchService::submit(Staged& staged) {
@@ -176,7 +156,7 @@ MissionView DispatchService::view(const Mission& m) const {
 
 void DispatchService::drain_preemption_events(Staged& staged) {
   for (const auto& e : preemption_.take_events()) {
-    if (commits_) staged.push_back([e](Store& store) { store.insert_preemption_event(e); });
+    stage(staged, [e](Store& store) { store.insert_preemption_event(e); });
     emit("preemption_" + e.kind, e.mission, e.detail, e.time_s);
   }
 }
@@ -199,13 +179,11 @@ std::optional<std::string> DispatchService::repair(Mission& m, const std::vector
 }
 
 void DispatchService::persist_route(Mission& m, const std::string& reason, double now_s, Staged& staged) {
-  if (commits_) {
-    // The geometry is rendered by the writer thread, off the request's path; the graph outlives the queue.
-    staged.push_back([&graph = graph_, id = m.row.id, revision = m.revision + 1, reason, route = m.route, now_s](Store& store) {
-      store.insert_route_revision(id, revision, reason, route.travel_time_s, route.length_m,
-                                  planner::route_to_geojson(graph, route, "dstar")["geometry"].dump(), now_s);
-    });
-  }
+  // The geometry is rendered by the writer thread, off the request's path; the graph outlives the queue.
+  stage(staged, [&graph = graph_, id = m.row.id, revision = m.revision + 1, reason, route = m.route, now_s](Store& store) {
+    store.insert_route_revision(id, revision, reason, route.travel_time_s, route.length_m,
+                                planner::route_to_geojson(graph, route, "dstar")["geometry"].dump(), now_s);
+  });
   ++m.revision;
   m.row.updated_s = now_s;
 }
@@ -220,6 +198,11 @@ void DispatchService::retime_signals(Mission& m, double now_s, Staged& staged) {
 void DispatchService::announce_route(Mission& m, const std::string& reason, double now_s, Staged& staged) {
   emit(m.revision == 1 ? "mission_created" : "route_changed", m.row.id, reason, now_s);
   retime_signals(m, now_s, staged);
+}
+
+void DispatchService::publish_route(Mission& m, const std::string& reason, double now_s, Staged& staged) {
+  persist_route(m, reason, now_s, staged);
+  announce_route(m, reason, now_s, staged);
 }
 
 MissionView DispatchService::create_mission(const MissionRequest& req, double now_s) {
@@ -269,7 +252,7 @@ MissionView DispatchService::create_mission(const MissionRequest& req, double no
     m->planner->replan();
     m->route = m->planner->route();
     if (!m->route.found) throw unprocessable("unreachable", "the destination cannot be reached from the origin");
-    if (commits_) staged.push_back([row = m->row](Store& store) { store.insert_mission(row); });
+    stage(staged, [row = m->row](Store& store) { store.insert_mission(row); });
     persist_route(*m, "dispatch", now_s, staged);
     // The database first: if it fails, nothing was shared and the request fails whole.
     submit(staged)->wait();
@@ -325,8 +308,8 @@ void DispatchService::require_active(const Mission& m) {
   }
 }
 
-void DispatchService::stage_state(const Mission& m, MissionState state, double now_s, Staged& staged) {
-  staged.push_back([id = m.row.id, state, now_s](Store& store) { store.update_mission_state(id, state, now_s); });
+void DispatchService::stage_state(const Mission& m, MissionState state, double now_s, Staged& staged) const {
+  stage(staged, [id = m.row.id, state, now_s](Store& store) { store.update_mission_state(id, state, now_s); });
 }
 
 void DispatchService::finish(Mission& m, MissionState state, double now_s, Staged& staged) {
@@ -353,7 +336,7 @@ MissionView DispatchService::cancel_mission(MissionId id, double now_s) {
   require_active(*m);
   Staged staged;
   // Stored first: if that fails, the mission is still active everywhere.
-  if (commits_) stage_state(*m, MissionState::cancelled, now_s, staged);
+  stage_state(*m, MissionState::cancelled, now_s, staged);
   submit(staged)->wait();
   finish(*m, MissionState::cancelled, now_s, staged);
   auto durable = submit(staged);
@@ -396,13 +379,13 @@ PositionResult DispatchService::report_position(const PositionReport& p, double 
     if (mp->row.state != MissionState::active) mp.reset();  // it ended in between
   }
   if (!mp) {
-    if (commits_) staged.push_back([p, now_s](Store& store) { store.insert_position(p, std::nullopt, now_s); });
+    stage(staged, [p, now_s](Store& store) { store.insert_position(p, std::nullopt, now_s); });
     result.durable = submit(staged);
     return result;
   }
   Mission& m = *mp;
   result.mission = m.row.id;
-  if (commits_) staged.push_back([p, id = m.row.id, now_s](Store& store) { store.insert_position(p, id, now_s); });
+  stage(staged, [p, id = m.row.id, now_s](Store& store) { store.insert_position(p, id, now_s); });
   m.last_position = p.position;
 
   // Signals behind the vehicle: every intersection of the old route before its current edge.
@@ -424,183 +407,19 @@ PositionResult DispatchService::report_position(const PositionReport& p, double 
   if (!m.route.found || m.route.length_m <= config_.arrival_radius_m ||
       maps::distance_m(snap.point, m.destination_local) <= config_.arrival_radius_m) {
     result.completed = true;
-    if (commits_) stage_state(m, MissionState::completed, now_s, staged);
+    stage_state(m, MissionState::completed, now_s, staged);
     finish(m, MissionState::completed, now_s, staged);
   } else {
     // The route changed if it is not the rest of the old one from the vehicle's edge on.
     const auto from = std::find(old_edges.begin(), old_edges.end(), m.route.edges.front());
     result.route_changed = !std::equal(from, old_edges.end(), m.route.edges.begin(), m.route.edges.end());
     if (result.route_changed) {
-      persist_route(m, reason, now_s, staged);
-      announce_route(m, reason, now_s, staged);
+      publish_route(m, reason, now_s, staged);
     } else {
       retime_signals(m, now_s, staged);
     }
   }
   result.durable = submit(staged);
-  return result;
-}
-
-std::vector<EdgeId> DispatchService::resolve_edges(const CongestionUpdate& u) const {
-  if (u.edge.has_value() == u.osm_way_id.has_value()) throw bad_request("each update needs exactly one of edge, osm_way_id");
-  if (u.edge) {
-    if (!u.edge->valid() || u.edge->index() >= graph_.edge_count()) {
-      throw unprocessable("unknown_edge", "edge " + std::to_string(u.edge->v) + " is not in the map (it has " +
-                                              std::to_string(graph_.edge_count()) + " edges)");
-    }
-    return {*u.edge};
-  }
-  std::vector<EdgeId> out;
-  auto [lo, hi] = edges_by_way_.equal_range(*u.osm_way_id);
-  for (auto it = lo; it != hi; ++it) out.push_back(it->second);
-  if (out.empty()) throw unprocessable("unknown_way", "OSM way " + std::to_string(*u.osm_way_id) + " is not in the map");
-  return out;
-}
-
-CongestionResult DispatchService::report_congestion(const std::vector<CongestionUpdate>& updates, double now_s) {
-  const auto started = std::chrono::steady_clock::now();
-  if (updates.empty()) throw bad_request("updates must hold at least one update");
-  if (updates.size() > 10000) throw bad_request("at most 10000 updates per request");
-  // Validate everything before changing anything: a request applies whole or not at all.
-  std::vector<std::pair<EdgeId, planner::EdgeCondition>> changes;
-  std::vector<std::optional<double>> expiry;
-  for (const CongestionUpdate& u : updates) {
-    const int given = (u.speed_kmh ? 1 : 0) + (u.travel_time_s ? 1 : 0) + (u.factor ? 1 : 0);
-    if (given != 1) throw bad_request("each update needs exactly one of speed_kmh, travel_time_s, factor");
-    if (u.expires_in_s && !(std::isfinite(*u.expires_in_s) && *u.expires_in_s > 0.0)) {
-      throw bad_request("expires_in_s must be a positive number of seconds");
-    }
-    if (u.speed_kmh && !(std::isfinite(*u.speed_kmh) && *u.speed_kmh >= 0.0 && *u.speed_kmh < 400.0)) {
-      throw bad_request("speed_kmh must be within [0, 400); 0 closes the road");
-    }
-    if (u.travel_time_s && !(std::isfinite(*u.travel_time_s) && *u.travel_time_s > 0.0)) {
-      throw bad_request("travel_time_s must be a positive number of seconds");
-    }
-    if (u.factor && !(*u.factor > 0.0) ) throw bad_request("factor must be positive (a very large factor closes the road)");
-    const std::vector<EdgeId> edges = resolve_edges(u);
-    // travel_time_s is the time of the whole edge or way (each road counted once, not per direction).
-    double free_flow_s = 0.0;
-    for (EdgeId e : edges) {
-      if (!graph_.twin(e).valid() || e < graph_.twin(e) || edges.size() == 1) free_flow_s += graph_.length_m(e) / graph_.speed_mps(e);
-    }
-    for (EdgeId e : edges) {
-      double factor = 1.0;
-      if (u.factor) factor = *u.factor;
-      if (u.speed_kmh) factor = *u.speed_kmh <= 0.0 ? planner::kInfCost : (graph_.speed_mps(e) * 3.6) / *u.speed_kmh;
-      if (u.travel_time_s) factor = *u.travel_time_s / free_flow_s;
-      changes.push_back({e, {factor, 0.0}});
-      expiry.push_back(u.expires_in_s ? std::optional<double>(now_s + *u.expires_in_s) : std::nullopt);
-    }
-  }
-
-  // One congestion change at a time, end to end; positions do not wait for it.
-  std::lock_guard serial(congestion_mutex_);
-  {
-    // A speed or factor update keeps the edge's queue delay.
-    std::shared_lock costs(overlay_mutex_);
-    for (auto& [e, condition] : changes) condition.queue_delay_s = overlay_.edge(e).queue_delay_s;
-  }
-  // Persist the whole batch before applying any of it, so a storage failure changes nothing.
-  if (commits_) {
-    commits_->run([&](Store& store) {
-      for (std::size_t i = 0; i < changes.size(); ++i) store.insert_congestion(changes[i].first, changes[i].second, expiry[i], now_s);
-    });
-  }
-  for (std::size_t i = 0; i < changes.size(); ++i) {
-    const std::uint64_t seq = ++update_sequence_;
-    latest_update_[changes[i].first] = seq;
-    if (expiry[i]) expiries_.emplace(*expiry[i], std::make_pair(changes[i].first, seq));
-  }
-  const std::vector<MissionPtr> affected = apply_changes(changes, "congestion");
-  emit("congestion_applied", 0, std::to_string(changes.size()) + " edges", now_s);
-  std::vector<std::shared_ptr<CommitTicket>> durable;
-  CongestionResult result = repair_plans(affected, now_s, started, durable);
-  result.edges_changed = changes.size();
-  for (const auto& t : durable) t->wait();
-  return result;
-}
-
-std::vector<DispatchService::MissionPtr> DispatchService::apply_changes(
-    const std::vector<std::pair<EdgeId, planner::EdgeCondition>>& changes, const std::string& reason) {
-  std::vector<EdgeId> edges;
-  edges.reserve(changes.size());
-  for (const auto& [e, condition] : changes) edges.push_back(e);
-  std::vector<MissionPtr> affected;
-  std::lock_guard costs(overlay_mutex_);
-  for (const auto& [e, condition] : changes) overlay_.set_edge(e, condition);
-  std::shared_lock registry(registry_mutex_);
-  for (const auto& [vehicle, id] : active_by_vehicle_) {
-    const MissionPtr& m = missions_.at(id);
-    std::lock_guard lock(m->pending_mutex);
-    m->pending_edges.insert(m->pending_edges.end(), edges.begin(), edges.end());
-    m->pending_reason = reason;
-    affected.push_back(m);
-  }
-  return affected;
-}
-
-void DispatchService::repair_one(Mission& m, double now_s, CongestionResult& result,
-                                 std::vector<std::shared_ptr<CommitTicket>>& durable) {
-  std::lock_guard lock(m.mutex);
-  if (m.row.state != MissionState::active) return;
-  ++result.missions_replanned;
-  const std::vector<EdgeId> before = m.route.edges;
-  const auto started = std::chrono::steady_clock::now();
-  const std::optional<std::string> reason = repair(m, nullptr);
-  const double took_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  result.slowest_replan_s = std::max(result.slowest_replan_s, took_s);
-  result.mission_replan_s.push_back(took_s);
-  if (!reason) return;  // a position report repaired it in the meantime
-  Staged staged;
-  if (m.route.edges != before) {
-    ++result.routes_changed;
-    persist_route(m, *reason, now_s, staged);
-    announce_route(m, *reason, now_s, staged);
-  } else {
-    // Same route, new costs: the arrival times moved, so the signals are re-timed.
-    retime_signals(m, now_s, staged);
-  }
-  durable.push_back(submit(staged));
-}
-
-CongestionResult DispatchService::repair_plans(const std::vector<MissionPtr>& missions, double now_s,
-                                               std::chrono::steady_clock::time_point started,
-                                               std::vector<std::shared_ptr<CommitTicket>>& durable) {
-  CongestionResult result;
-  // The calling thread and the pool's take missions off one counter; a mission's own lock keeps
-  // position reports out of its plan while it is repaired, and lets other missions' reports through.
-  std::atomic<std::size_t> next{0};
-  std::mutex merge_mutex;
-  std::exception_ptr failure;
-  const auto drain = [&] {
-    CongestionResult mine;
-    std::vector<std::shared_ptr<CommitTicket>> tickets;
-    try {
-      for (std::size_t i = next++; i < missions.size(); i = next++) repair_one(*missions[i], now_s, mine, tickets);
-    } catch (...) {
-      std::lock_guard lock(merge_mutex);
-      if (!failure) failure = std::current_exception();
-    }
-    std::lock_guard lock(merge_mutex);
-    result.missions_replanned += mine.missions_replanned;
-    result.routes_changed += mine.routes_changed;
-    result.slowest_replan_s = std::max(result.slowest_replan_s, mine.slowest_replan_s);
-    result.mission_replan_s.insert(result.mission_replan_s.end(), mine.mission_replan_s.begin(), mine.mission_replan_s.end());
-    durable.insert(durable.end(), tickets.begin(), tickets.end());
-  };
-  const std::size_t helpers =
-      repair_pool_ ? std::min(static_cast<std::size_t>(config_.repair_threads - 1), missions.size() / 2) : 0;
-  std::latch helpers_done(static_cast<std::ptrdiff_t>(helpers));
-  for (std::size_t h = 0; h < helpers; ++h) {
-    boost::asio::post(*repair_pool_, [&] {
-      drain();
-      helpers_done.count_down();
-    });
-  }
-  drain();
-  helpers_done.wait();
-  if (failure) std::rethrow_exception(failure);
-  result.replan_latency_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;
 }
 
@@ -612,34 +431,6 @@ void DispatchService::report_counts(NodeId node, maps::Compass approach, double 
   } catch (const preemption::CountError& e) {
     throw bad_request(e.what());
   }
-}
-
-void DispatchService::tick(double now_s) {
-  {
-    std::lock_guard serial(congestion_mutex_);
-    std::vector<std::pair<EdgeId, planner::EdgeCondition>> expired;
-    while (!expiries_.empty() && expiries_.begin()->first <= now_s) {
-      const auto [e, seq] = expiries_.begin()->second;
-      expiries_.erase(expiries_.begin());
-      // An expiry ends only the update it came with; a later update of the edge stays in force.
-      if (latest_update_[e] != seq) continue;
-      latest_update_.erase(e);
-      expired.push_back({e, planner::EdgeCondition{}});
-    }
-    if (!expired.empty()) {
-      // Nobody waits for the tick's writes; a failure is logged by the queue.
-      std::vector<std::shared_ptr<CommitTicket>> durable;
-      repair_plans(apply_changes(expired, "congestion_expired"), now_s, std::chrono::steady_clock::now(), durable);
-    }
-  }
-  Staged staged;
-  {
-    std::lock_guard lock(preemption_mutex_);
-    signals_.advance(now_s);
-    preemption_.tick(now_s);
-    drain_preemption_events(staged);
-  }
-  submit(staged);
 }
 
 std::vector<preemption::Light> DispatchService::signal_lights(NodeId node) const {
@@ -700,8 +491,7 @@ void DispatchService::restore(double now_s) {
       missions_[row.id] = m;
       active_by_vehicle_[row.vehicle_id] = row.id;
       last_position_[row.vehicle_id] = start;
-      persist_route(*m, "restart", now_s, staged);
-      announce_route(*m, "restart", now_s, staged);
+      publish_route(*m, "restart", now_s, staged);
       spdlog::info("event=mission_resumed mission={} vehicle={}", row.id, row.vehicle_id);
     } catch (const maps::SnapError& e) {
       spdlog::error("event=mission_not_resumable mission={} reason=\"{}\"", row.id, e.what());

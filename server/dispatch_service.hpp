@@ -92,9 +92,10 @@ class DispatchService {
   // returns the reason of a cost change it had not repaired yet, if any.
   std::optional<std::string> repair(Mission& m, const std::vector<planner::EdgePoint>* new_start);
   // A new route revision: persist_route stages its write; announce_route re-times the signals
-  // and tells the listeners.
+  // and tells the listeners; publish_route does both. Creating a mission stores before it announces.
   void persist_route(Mission& m, const std::string& reason, double now_s, Staged& staged);
   void announce_route(Mission& m, const std::string& reason, double now_s, Staged& staged);
+  void publish_route(Mission& m, const std::string& reason, double now_s, Staged& staged);
   void retime_signals(Mission& m, double now_s, Staged& staged);
   // Applies edge changes to the overlay and tells every active planner of them; returns those missions.
   std::vector<MissionPtr> apply_changes(const std::vector<std::pair<EdgeId, planner::EdgeCondition>>& changes,
@@ -110,7 +111,9 @@ class DispatchService {
   MissionView view(const Mission& m) const;
   // Ends a mission in memory; the caller stores the new state (stage_state) first.
   void finish(Mission& m, MissionState state, double now_s, Staged& staged);
-  static void stage_state(const Mission& m, MissionState state, double now_s, Staged& staged);
+  void stage_state(const Mission& m, MissionState state, double now_s, Staged& staged) const;
+  // Adds a write to a call's batch; without a store there is nothing to write.
+  void stage(Staged& staged, CommitQueue::Write write) const;
   std::shared_ptr<CommitTicket> submit(Staged& staged);
   std::vector<EdgeId> resolve_edges(const CongestionUpdate& u) const;
   void restore(double now_s);

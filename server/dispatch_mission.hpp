@@ -1,0 +1,35 @@
+// One mission's state inside the dispatch service: its row, planner and route, each confined to
+// the mission's own lock. Private to the service's implementation files.
+#pragma once
+
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "server/dispatch_service.hpp"
+
+namespace corridor::server {
+
+struct DispatchService::Mission {
+  // Confines everything below but the pending changes: one request works on a mission at a time.
+  mutable std::mutex mutex;
+  MissionRow row;
+  std::optional<maps::LatLon> last_position;
+  maps::Point2 destination_local;
+  std::unique_ptr<planner::TravelCost> cost;
+  std::unique_ptr<planner::DStarLite> planner;
+  planner::Route route;
+  std::uint32_t revision = 0;
+  std::vector<preemption::ScheduleEntry> final_schedule;  // kept when the engine forgets the mission
+
+  // Edges whose cost changed since the planner last heard, and the reason to give if the repaired
+  // route differs. Appended under the overlay's exclusive lock, taken under its shared lock, so a
+  // repair sees exactly the costs it was told of.
+  std::mutex pending_mutex;
+  std::vector<EdgeId> pending_edges;
+  std::optional<std::string> pending_reason;
+};
+
+}  // namespace corridor::server
