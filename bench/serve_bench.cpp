@@ -87,6 +87,8 @@ class LoadConnection {
   // Sees each successful response's body (on the client thread that read it).
   void on_body(std::function<void(const std::string&)> f) { on_body_ = std::move(f); }
   [[nodiscard]] const std::vector<double>& latencies_ms() const { return latencies_ms_; }
+  // How late each request left against its schedule: the load generator's own share of the latency.
+  [[nodiscard]] const std::vector<double>& send_lags_ms() const { return send_lags_ms_; }
   [[nodiscard]] std::uint64_t errors() const { return errors_; }
 
  private:
@@ -101,6 +103,7 @@ class LoadConnection {
     });
   }
   void send() {
+    send_lags_ms_.push_back(std::chrono::duration<double, std::milli>(Clock::now() - due_).count());
     req_.body() = next_body_();
     req_.prepare_payload();
     http::async_write(stream_, req_, [this](beast::error_code ec, std::size_t) {
@@ -132,6 +135,7 @@ class LoadConnection {
   http::response<http::string_body> res_;
   beast::flat_buffer buffer_;
   std::vector<double> latencies_ms_;
+  std::vector<double> send_lags_ms_;
   std::uint64_t errors_ = 0;
 };
 
@@ -283,8 +287,10 @@ json run_serve_bench(const maps::RoadGraph& graph, const ServeBenchConfig& c) {
   const double elapsed = std::chrono::duration<double>(Clock::now() - started).count();
   std::uint64_t errors = sensor.errors();
   std::vector<double> all;
+  std::vector<double> send_lags;
   for (const auto& v : vehicles) {
     all.insert(all.end(), v->latencies_ms().begin(), v->latencies_ms().end());
+    send_lags.insert(send_lags.end(), v->send_lags_ms().begin(), v->send_lags_ms().end());
     errors += v->errors();
   }
   const std::vector<double>& congestion_ms = sensor.latencies_ms();
@@ -305,6 +311,11 @@ json run_serve_bench(const maps::RoadGraph& graph, const ServeBenchConfig& c) {
   out["positions"] = latency_json(all);
   out["positions"]["per_s"] = static_cast<double>(all.size()) / elapsed;
   out["positions"]["p99_ms"] = percentile(all, 0.99);
+  // Paced runs only: how late the load generator itself sent, on the cores it shares with the server.
+  if (c.rate_per_s > 0) {
+    out["positions"]["send_lag_ms"] = latency_json(send_lags);
+    out["positions"]["send_lag_ms"]["p99_ms"] = percentile(send_lags, 0.99);
+  }
   out["congestion"] = latency_json(congestion_ms);
   out["congestion"]["p99_ms"] = percentile(congestion_ms, 0.99);
   // Server side, per request: from its arrival to the last mission's repaired route.

@@ -163,7 +163,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
       return;
     }
     // The answer may come from the commit thread once the request's writes are durable, or from a
-    // worker; it is written from this connection's strand.
+    // worker; it is written on this connection's own io_context.
     HttpRequest request{std::string(req.method_string()), target, std::string(req[http::field::authorization]),
                         std::move(req.body())};
     auto reply = [self = shared_from_this(), keep_alive = req.keep_alive()](HttpResponse r) {
@@ -219,11 +219,23 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
 
 struct HttpServer::Impl {
   Impl(Router& r, DispatchService& s, ServerLimits l, int n)
-      : router(r), service(s), limits(l), threads(std::max(1, n)), ioc(threads), acceptor(net::make_strand(ioc)),
-        signals(ioc, SIGINT, SIGTERM), ticker(ioc), accept_retry(ioc) {}
+      : router(r), service(s), limits(l), shards(make_shards(std::max(1, n))), ioc(*shards.front()),
+        acceptor(ioc), signals(ioc, SIGINT, SIGTERM), ticker(ioc), accept_retry(ioc) {
+    for (auto& shard : shards) keep_running.push_back(net::make_work_guard(*shard));
+  }
+
+  // One io_context per I/O thread, each connection on one of them for its whole life: a
+  // connection's handlers then never run concurrently, which is what a strand would give, without
+  // the threads contending for one scheduler's lock on every completion.
+  static std::vector<std::unique_ptr<net::io_context>> make_shards(int n) {
+    std::vector<std::unique_ptr<net::io_context>> out;
+    for (int i = 0; i < n; ++i) out.push_back(std::make_unique<net::io_context>(1));
+    return out;
+  }
+  net::io_context& next_shard() { return *shards[next++ % shards.size()]; }
 
   void accept() {
-    acceptor.async_accept(net::make_strand(ioc), [this](beast::error_code ec, tcp::socket socket) {
+    acceptor.async_accept(next_shard(), [this](beast::error_code ec, tcp::socket socket) {
       if (!acceptor.is_open() || ec == net::error::operation_aborted) return;  // stopping
       if (!ec) {
         std::make_shared<HttpSession>(std::move(socket), router, hub, limits, workers)->run();
@@ -262,8 +274,10 @@ struct HttpServer::Impl {
   Router& router;
   DispatchService& service;
   ServerLimits limits;
-  int threads;
-  net::io_context ioc;
+  std::vector<std::unique_ptr<net::io_context>> shards;
+  net::io_context& ioc;  // the first shard; it also accepts, ticks and takes signals
+  std::vector<net::executor_work_guard<net::io_context::executor_type>> keep_running;
+  std::size_t next = 0;  // the shard of the next accepted connection (only the accept handler uses it)
   tcp::acceptor acceptor;
   net::signal_set signals;
   net::steady_timer ticker;
@@ -312,7 +326,7 @@ void HttpServer::run() {
   impl_->tick();
   impl_->signals.async_wait([this](beast::error_code, int) { stop(); });
   std::vector<std::thread> pool;
-  for (int i = 1; i < impl_->threads; ++i) pool.emplace_back([this] { impl_->ioc.run(); });
+  for (std::size_t i = 1; i < impl_->shards.size(); ++i) pool.emplace_back([this, i] { impl_->shards[i]->run(); });
   impl_->ioc.run();
   for (auto& t : pool) t.join();
 }
@@ -326,7 +340,7 @@ void HttpServer::stop() {
     impl->accept_retry.cancel();
     impl->signals.cancel();
   });
-  impl_->ioc.stop();
+  for (auto& shard : impl_->shards) shard->stop();
 }
 
 }  // namespace corridor::server

@@ -1,6 +1,7 @@
 // The HTTP/WebSocket transport (Boost.Beast over Asio): accepts connections, enforces size limits
 // and timeouts, hands each request to the Router, and streams dispatch events to WebSocket clients
-// on GET /v1/stream. One strand per connection; the Router and service do the rest.
+// on GET /v1/stream. Each connection lives on one single-threaded io_context; the Router and
+// service do the rest.
 #pragma once
 
 #include <cstddef>
@@ -30,7 +31,8 @@ class HttpServer {
   HttpServer& operator=(const HttpServer&) = delete;
 
   [[nodiscard]] unsigned short port() const;
-  // Runs until stop(), SIGINT or SIGTERM; ticks the service once a second.
+  // Runs until stop(), SIGINT or SIGTERM, on `threads` threads, one io_context each; ticks the
+  // service once a second.
   void run();
   void stop();
 

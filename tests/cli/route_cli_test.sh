@@ -149,9 +149,9 @@ PY
 then pass; else fail "preemption tables --json"; fi
 "$corridor" preemption tables | grep -q "agree in 12 of 96 cells" && pass || fail "preemption tables text"
 
-# 7. The server load benchmark: a short run on the embedded map keeps its keys, answers every
+# 7. The server load benchmark: a short paced run on the embedded map keeps its keys, answers every
 # request, and reads back one per-mission repair sample for each congestion-triggered replan.
-"$corridor" bench serve --seconds 1.5 --vehicles 20 --missions 10 --congestion-edges-per-s 400 > "$work/serve.json" 2> /dev/null
+"$corridor" bench serve --seconds 1.5 --rate 400 --vehicles 20 --missions 10 --congestion-edges-per-s 400 > "$work/serve.json" 2> /dev/null
 if python3 - "$work/serve.json" <<'PY'
 import json, sys
 j = json.load(open(sys.argv[1]))
@@ -161,6 +161,8 @@ assert p["count"] > 0 and p["per_s"] > 0 and 0 <= p["p50_ms"] <= p["p99_ms"] <= 
 assert c["count"] > 0 and c["replan_latency_ms"]["count"] == c["count"], c
 s = p["server_side"]
 assert s["count"] == p["count"], (s["count"], p["count"])  # every answered position, timed by the server too
+lag = p["send_lag_ms"]  # paced: each request left before its answer came, so its lag is under its latency
+assert lag["count"] == p["count"] and 0 <= lag["p50_ms"] <= lag["p99_ms"] <= lag["max_ms"] <= p["max_ms"], (lag, p)
 r = c["mission_replans"]
 assert r["count"] > 0, r
 shares = [b["share"] for b in r["share_within"]]
