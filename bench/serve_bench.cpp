@@ -1,10 +1,13 @@
 #include "bench/serve_bench.hpp"
 
+#include <spdlog/fmt/fmt.h>
 #include <spdlog/spdlog.h>
 
 #include <boost/asio.hpp>
 #include <boost/beast.hpp>
+#include <cctype>
 #include <chrono>
+#include <cstdlib>
 #include <cmath>
 #include <filesystem>
 #include <functional>
@@ -62,26 +65,25 @@ class Client {
 // A paced request's latency counts from its scheduled send time, so a server that falls behind
 // cannot hide its queueing (no coordinated omission). Each connection runs one chain of
 // operations at a time, so it needs no strand even with several client threads.
+//
+// The load generator shares the cores with the server it measures, so it writes each request as
+// one preformatted buffer and reads only the status line and Content-Length of the answer (the
+// server always sends one), like wrk, rather than building and parsing full messages.
 class LoadConnection {
  public:
   LoadConnection(net::io_context& ioc, unsigned short port, const std::string& target,
                  std::function<std::string()> next_body, double period_s, Clock::time_point deadline,
                  Clock::time_point first)
-      : stream_(ioc),
+      : socket_(ioc),
         timer_(ioc),
         next_body_(std::move(next_body)),
         period_(std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(period_s))),
         deadline_(deadline),
-        due_(first) {
-    stream_.connect(tcp::endpoint(net::ip::make_address("127.0.0.1"), port));
-    stream_.socket().set_option(tcp::no_delay(true));
-    req_.method(http::verb::post);
-    req_.target(target);
-    req_.version(11);
-    req_.set(http::field::host, "127.0.0.1");
-    req_.set(http::field::authorization, "Bearer " + kToken);
-    req_.set(http::field::content_type, "application/json");
-    req_.keep_alive(true);
+        due_(first),
+        head_("POST " + target + " HTTP/1.1\r\nHost: 127.0.0.1\r\nAuthorization: Bearer " + kToken +
+              "\r\nContent-Type: application/json\r\nContent-Length: ") {
+    socket_.connect(tcp::endpoint(net::ip::make_address("127.0.0.1"), port));
+    socket_.set_option(tcp::no_delay(true));
   }
   void start() { schedule(); }
   // Sees each successful response's body (on the client thread that read it).
@@ -89,6 +91,9 @@ class LoadConnection {
   [[nodiscard]] const std::vector<double>& latencies_ms() const { return latencies_ms_; }
   // How late each request left against its schedule: the load generator's own share of the latency.
   [[nodiscard]] const std::vector<double>& send_lags_ms() const { return send_lags_ms_; }
+  // From each request leaving to its answer: the server's and the kernel's share, without the
+  // generator's lateness (what a load generator that waits for its own schedule would report).
+  [[nodiscard]] const std::vector<double>& after_send_ms() const { return after_send_ms_; }
   [[nodiscard]] std::uint64_t errors() const { return errors_; }
 
  private:
@@ -98,44 +103,75 @@ class LoadConnection {
     if (due_ >= deadline_) return;
     if (due_ <= now) return send();
     timer_.expires_at(due_);
-    timer_.async_wait([this](beast::error_code ec) {
+    timer_.async_wait([this](boost::system::error_code ec) {
       if (!ec) send();
     });
   }
   void send() {
-    send_lags_ms_.push_back(std::chrono::duration<double, std::milli>(Clock::now() - due_).count());
-    req_.body() = next_body_();
-    req_.prepare_payload();
-    http::async_write(stream_, req_, [this](beast::error_code ec, std::size_t) {
+    sent_ = Clock::now();
+    send_lags_ms_.push_back(std::chrono::duration<double, std::milli>(sent_ - due_).count());
+    const std::string body = next_body_();
+    out_.assign(head_).append(std::to_string(body.size())).append("\r\n\r\n").append(body);
+    net::async_write(socket_, net::buffer(out_), [this](boost::system::error_code ec, std::size_t) {
       if (ec) return fail();
-      res_ = {};
-      http::async_read(stream_, buffer_, res_, [this](beast::error_code read_ec, std::size_t) {
-        if (read_ec) return fail();
-        latencies_ms_.push_back(std::chrono::duration<double, std::milli>(Clock::now() - due_).count());
-        if (res_.result_int() != 200) {
-          ++errors_;
-        } else if (on_body_) {
-          on_body_(res_.body());
-        }
-        due_ += period_;
-        schedule();
-      });
+      net::async_read_until(socket_, net::dynamic_buffer(in_), "\r\n\r\n",
+                            [this](boost::system::error_code read_ec, std::size_t head_size) {
+                              if (read_ec) return fail();
+                              read_body(head_size);
+                            });
     });
   }
-  void fail() { ++errors_; }  // the connection is gone; this vehicle stops reporting
+  void read_body(std::size_t head_size) {
+    const std::string_view head(in_.data(), head_size);
+    const auto length = content_length(head);
+    const int status = head.size() > 12 && head.substr(0, 5) == "HTTP/" ? std::atoi(in_.data() + 9) : 0;
+    if (!length || status == 0) return fail();
+    const std::size_t total = head_size + *length;
+    const std::size_t have = in_.size();
+    const auto done = [this, head_size, total, status](boost::system::error_code ec, std::size_t) {
+      if (ec) return fail();
+      const auto now = Clock::now();
+      latencies_ms_.push_back(std::chrono::duration<double, std::milli>(now - due_).count());
+      after_send_ms_.push_back(std::chrono::duration<double, std::milli>(now - sent_).count());
+      if (status != 200) {
+        ++errors_;
+      } else if (on_body_) {
+        on_body_(in_.substr(head_size, total - head_size));
+      }
+      in_.erase(0, total);
+      due_ += period_;
+      schedule();
+    };
+    if (have >= total) return done({}, 0);
+    net::async_read(socket_, net::dynamic_buffer(in_), net::transfer_exactly(total - have), done);
+  }
+  static std::optional<std::size_t> content_length(std::string_view head) {
+    constexpr std::string_view kName = "\r\ncontent-length:";
+    for (std::size_t i = 0; i + kName.size() <= head.size(); ++i) {
+      bool match = true;
+      for (std::size_t k = 0; k < kName.size() && match; ++k) {
+        match = std::tolower(static_cast<unsigned char>(head[i + k])) == kName[k];
+      }
+      if (match) return std::strtoull(head.data() + i + kName.size(), nullptr, 10);
+    }
+    return std::nullopt;
+  }
+  void fail() { ++errors_; }  // the connection is gone or answered garbage; this vehicle stops reporting
 
-  beast::tcp_stream stream_;
+  tcp::socket socket_;
   net::steady_timer timer_;
   std::function<std::string()> next_body_;
   std::function<void(const std::string&)> on_body_;
   Clock::duration period_;
   Clock::time_point deadline_;
   Clock::time_point due_;
-  http::request<http::string_body> req_;
-  http::response<http::string_body> res_;
-  beast::flat_buffer buffer_;
+  Clock::time_point sent_;
+  const std::string head_;
+  std::string out_;
+  std::string in_;
   std::vector<double> latencies_ms_;
   std::vector<double> send_lags_ms_;
+  std::vector<double> after_send_ms_;
   std::uint64_t errors_ = 0;
 };
 
@@ -248,9 +284,10 @@ json run_serve_bench(const maps::RoadGraph& graph, const ServeBenchConfig& c) {
     const std::string target = "/v1/vehicles/v" + std::to_string(v) + "/position";
     auto next_body = [&track, last, step = std::size_t{0}]() mutable {
       const json& p = track[std::min(step / 20, last)];
-      const json body{{"lat", p["lat"]}, {"lon", p["lon"]}, {"timestamp", static_cast<double>(step)}, {"source", "gps"}};
+      std::string body = fmt::format(R"({{"lat":{},"lon":{},"timestamp":{},"source":"gps"}})", p["lat"].get<double>(),
+                                     p["lon"].get<double>(), step);
       ++step;
-      return body.dump();
+      return body;
     };
     // Spread the vehicles' first reports over one period so that a paced load arrives evenly.
     const auto phase = std::chrono::duration<double>(per_vehicle_period_s * v / c.vehicles);
@@ -288,9 +325,11 @@ json run_serve_bench(const maps::RoadGraph& graph, const ServeBenchConfig& c) {
   std::uint64_t errors = sensor.errors();
   std::vector<double> all;
   std::vector<double> send_lags;
+  std::vector<double> after_send;
   for (const auto& v : vehicles) {
     all.insert(all.end(), v->latencies_ms().begin(), v->latencies_ms().end());
     send_lags.insert(send_lags.end(), v->send_lags_ms().begin(), v->send_lags_ms().end());
+    after_send.insert(after_send.end(), v->after_send_ms().begin(), v->after_send_ms().end());
     errors += v->errors();
   }
   const std::vector<double>& congestion_ms = sensor.latencies_ms();
@@ -315,6 +354,8 @@ json run_serve_bench(const maps::RoadGraph& graph, const ServeBenchConfig& c) {
   if (c.rate_per_s > 0) {
     out["positions"]["send_lag_ms"] = latency_json(send_lags);
     out["positions"]["send_lag_ms"]["p99_ms"] = percentile(send_lags, 0.99);
+    out["positions"]["after_send_ms"] = latency_json(after_send);
+    out["positions"]["after_send_ms"]["p99_ms"] = percentile(after_send, 0.99);
   }
   out["congestion"] = latency_json(congestion_ms);
   out["congestion"]["p99_ms"] = percentile(congestion_ms, 0.99);

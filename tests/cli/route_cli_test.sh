@@ -163,6 +163,8 @@ s = p["server_side"]
 assert s["count"] == p["count"], (s["count"], p["count"])  # every answered position, timed by the server too
 lag = p["send_lag_ms"]  # paced: each request left before its answer came, so its lag is under its latency
 assert lag["count"] == p["count"] and 0 <= lag["p50_ms"] <= lag["p99_ms"] <= lag["max_ms"] <= p["max_ms"], (lag, p)
+after = p["after_send_ms"]  # and the part after it left is under the latency too
+assert after["count"] == p["count"] and 0 < after["p50_ms"] <= after["p99_ms"] <= after["max_ms"] <= p["max_ms"], (after, p)
 r = c["mission_replans"]
 assert r["count"] > 0, r
 shares = [b["share"] for b in r["share_within"]]
