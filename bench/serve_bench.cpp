@@ -5,9 +5,7 @@
 
 #include <boost/asio.hpp>
 #include <boost/beast.hpp>
-#include <cctype>
 #include <chrono>
-#include <cstdlib>
 #include <cmath>
 #include <filesystem>
 #include <functional>
@@ -67,8 +65,7 @@ class Client {
 // operations at a time, so it needs no strand even with several client threads.
 //
 // The load generator shares the cores with the server it measures, so it writes each request as
-// one preformatted buffer and reads only the status line and Content-Length of the answer (the
-// server always sends one), like wrk, rather than building and parsing full messages.
+// one preformatted buffer, like wrk, rather than building and serializing a message each time.
 class LoadConnection {
  public:
   LoadConnection(net::io_context& ioc, unsigned short port, const std::string& target,
@@ -114,49 +111,23 @@ class LoadConnection {
     out_.assign(head_).append(std::to_string(body.size())).append("\r\n\r\n").append(body);
     net::async_write(socket_, net::buffer(out_), [this](boost::system::error_code ec, std::size_t) {
       if (ec) return fail();
-      net::async_read_until(socket_, net::dynamic_buffer(in_), "\r\n\r\n",
-                            [this](boost::system::error_code read_ec, std::size_t head_size) {
-                              if (read_ec) return fail();
-                              read_body(head_size);
-                            });
+      res_ = {};
+      http::async_read(socket_, buffer_, res_, [this](beast::error_code read_ec, std::size_t) {
+        if (read_ec) return fail();
+        const auto now = Clock::now();
+        latencies_ms_.push_back(std::chrono::duration<double, std::milli>(now - due_).count());
+        after_send_ms_.push_back(std::chrono::duration<double, std::milli>(now - sent_).count());
+        if (res_.result_int() != 200) {
+          ++errors_;
+        } else if (on_body_) {
+          on_body_(res_.body());
+        }
+        due_ += period_;
+        schedule();
+      });
     });
   }
-  void read_body(std::size_t head_size) {
-    const std::string_view head(in_.data(), head_size);
-    const auto length = content_length(head);
-    const int status = head.size() > 12 && head.substr(0, 5) == "HTTP/" ? std::atoi(in_.data() + 9) : 0;
-    if (!length || status == 0) return fail();
-    const std::size_t total = head_size + *length;
-    const std::size_t have = in_.size();
-    const auto done = [this, head_size, total, status](boost::system::error_code ec, std::size_t) {
-      if (ec) return fail();
-      const auto now = Clock::now();
-      latencies_ms_.push_back(std::chrono::duration<double, std::milli>(now - due_).count());
-      after_send_ms_.push_back(std::chrono::duration<double, std::milli>(now - sent_).count());
-      if (status != 200) {
-        ++errors_;
-      } else if (on_body_) {
-        on_body_(in_.substr(head_size, total - head_size));
-      }
-      in_.erase(0, total);
-      due_ += period_;
-      schedule();
-    };
-    if (have >= total) return done({}, 0);
-    net::async_read(socket_, net::dynamic_buffer(in_), net::transfer_exactly(total - have), done);
-  }
-  static std::optional<std::size_t> content_length(std::string_view head) {
-    constexpr std::string_view kName = "\r\ncontent-length:";
-    for (std::size_t i = 0; i + kName.size() <= head.size(); ++i) {
-      bool match = true;
-      for (std::size_t k = 0; k < kName.size() && match; ++k) {
-        match = std::tolower(static_cast<unsigned char>(head[i + k])) == kName[k];
-      }
-      if (match) return std::strtoull(head.data() + i + kName.size(), nullptr, 10);
-    }
-    return std::nullopt;
-  }
-  void fail() { ++errors_; }  // the connection is gone or answered garbage; this vehicle stops reporting
+  void fail() { ++errors_; }  // the connection is gone; this vehicle stops reporting
 
   tcp::socket socket_;
   net::steady_timer timer_;
@@ -168,7 +139,8 @@ class LoadConnection {
   Clock::time_point sent_;
   const std::string head_;
   std::string out_;
-  std::string in_;
+  beast::flat_buffer buffer_;
+  http::response<http::string_body> res_;
   std::vector<double> latencies_ms_;
   std::vector<double> send_lags_ms_;
   std::vector<double> after_send_ms_;
