@@ -121,6 +121,7 @@ LatencySummary summarize_ms(std::vector<double> samples) {
   };
   s.p50_ms = rank(0.50);
   s.p95_ms = rank(0.95);
+  s.p99_ms = rank(0.99);
   s.max_ms = samples.back();
   double sum = 0;
   for (double x : samples) sum += x;
@@ -244,11 +245,12 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
   return res;
 }
 
+nlohmann::json to_json(const LatencySummary& s) {
+  return {{"count", s.count},   {"p50_ms", s.p50_ms}, {"p95_ms", s.p95_ms}, {"p99_ms", s.p99_ms},
+          {"max_ms", s.max_ms}, {"mean_ms", s.mean_ms}};
+}
+
 nlohmann::json to_json(const ReplanBenchResult& r, const ReplanBenchConfig& c) {
-  auto lat = [](const LatencySummary& s) {
-    return nlohmann::json{{"count", s.count}, {"p50_ms", s.p50_ms}, {"p95_ms", s.p95_ms}, {"max_ms", s.max_ms},
-                          {"mean_ms", s.mean_ms}};
-  };
   auto ratio = [](double a, double b) { return b > 0 ? a / b : 0.0; };
   nlohmann::json j;
   j["graph"] = {{"nodes", r.nodes}, {"edges", r.edges}};
@@ -262,17 +264,17 @@ nlohmann::json to_json(const ReplanBenchResult& r, const ReplanBenchConfig& c) {
                      {"clearing", c.clearing_fraction}};
   j["replans"] = r.replans;
   j["route_changes"] = r.route_changes;
-  j["dstar"] = lat(r.dstar);
+  j["dstar"] = to_json(r.dstar);
   j["dstar"]["mean_expanded"] = r.dstar_mean_expanded;
   j["dstar"]["mean_rekeyed"] = r.dstar_mean_rekeyed;
   j["dstar"]["mean_raised"] = r.dstar_mean_raised;
-  j["astar"] = lat(r.astar);
+  j["astar"] = to_json(r.astar);
   j["astar"]["mean_settled"] = r.astar_mean_settled;
   if (c.run_dijkstra) {
-    j["dijkstra"] = lat(r.dijkstra);
+    j["dijkstra"] = to_json(r.dijkstra);
     j["dijkstra"]["mean_settled"] = r.dijkstra_mean_settled;
   }
-  j["initial_plan"] = {{"dstar", lat(r.dstar_initial)}, {"astar", lat(r.astar_initial)}};
+  j["initial_plan"] = {{"dstar", to_json(r.dstar_initial)}, {"astar", to_json(r.astar_initial)}};
   j["speedup_p50_vs_astar"] = ratio(r.astar.p50_ms, r.dstar.p50_ms);
   j["speedup_p50_vs_dijkstra"] = c.run_dijkstra ? ratio(r.dijkstra.p50_ms, r.dstar.p50_ms) : 0.0;
   j["mismatches"] = r.mismatches;

@@ -32,11 +32,13 @@ struct LatencySummary {
   std::size_t count = 0;
   double p50_ms = 0;
   double p95_ms = 0;
+  double p99_ms = 0;
   double max_ms = 0;
   double mean_ms = 0;
 };
 
 LatencySummary summarize_ms(std::vector<double> samples_ms);
+nlohmann::json to_json(const LatencySummary& s);
 
 struct ReplanBenchResult {
   std::size_t nodes = 0;

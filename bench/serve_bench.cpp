@@ -152,16 +152,7 @@ json ll(const maps::RoadGraph& g, maps::Point2 p) {
   return {{"lat", x.lat_deg}, {"lon", x.lon_deg}};
 }
 
-json latency_json(std::vector<double> ms) {
-  const LatencySummary s = summarize_ms(std::move(ms));
-  return {{"count", s.count}, {"p50_ms", s.p50_ms}, {"p95_ms", s.p95_ms}, {"max_ms", s.max_ms}, {"mean_ms", s.mean_ms}};
-}
-
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<std::size_t>(std::ceil(q * static_cast<double>(v.size()))) - 1)];
-}
+json latency_json(std::vector<double> ms) { return to_json(summarize_ms(std::move(ms))); }
 
 // A Prometheus histogram (with these labels) read back from the server's /metrics: how many
 // samples, the share within each bucket bound, and the smallest bound that holds 99 % of them (an
@@ -321,21 +312,15 @@ json run_serve_bench(const maps::RoadGraph& graph, const ServeBenchConfig& c) {
                    {"seconds", c.seconds}, {"rate_per_s", c.rate_per_s}, {"client_threads", c.client_threads}, {"server_threads", c.server_threads}};
   out["positions"] = latency_json(all);
   out["positions"]["per_s"] = static_cast<double>(all.size()) / elapsed;
-  out["positions"]["p99_ms"] = percentile(all, 0.99);
   // Paced runs only: how late the load generator itself sent, on the cores it shares with the server.
   if (c.rate_per_s > 0) {
     out["positions"]["send_lag_ms"] = latency_json(send_lags);
-    out["positions"]["send_lag_ms"]["p99_ms"] = percentile(send_lags, 0.99);
     out["positions"]["after_send_ms"] = latency_json(after_send);
-    out["positions"]["after_send_ms"]["p99_ms"] = percentile(after_send, 0.99);
   }
   out["congestion"] = latency_json(congestion_ms);
-  out["congestion"]["p99_ms"] = percentile(congestion_ms, 0.99);
   // Server side, per request: from its arrival to the last mission's repaired route.
   out["congestion"]["replan_latency_ms"] = latency_json(replan_latency_ms);
-  out["congestion"]["replan_latency_ms"]["p99_ms"] = percentile(replan_latency_ms, 0.99);
   out["congestion"]["slowest_mission_replan_ms"] = latency_json(slowest_replan_ms);
-  out["congestion"]["slowest_mission_replan_ms"]["p99_ms"] = percentile(slowest_replan_ms, 0.99);
   // Every single mission repair the congestion caused, from the server's own histogram.
   out["congestion"]["mission_replans"] =
       histogram_from_metrics(metrics_status == 200 ? metrics_text : "", "corridor_congestion_mission_replan_seconds");

@@ -50,7 +50,7 @@ CongestionResult DispatchService::report_congestion(const std::vector<Congestion
     if (u.travel_time_s && !(std::isfinite(*u.travel_time_s) && *u.travel_time_s > 0.0)) {
       throw bad_request("travel_time_s must be a positive number of seconds");
     }
-    if (u.factor && !(*u.factor > 0.0) ) throw bad_request("factor must be positive (a very large factor closes the road)");
+    if (u.factor && !(*u.factor > 0.0)) throw bad_request("factor must be positive (a very large factor closes the road)");
     const std::vector<EdgeId> edges = resolve_edges(u);
     // travel_time_s is the time of the whole edge or way (each road counted once, not per direction).
     double free_flow_s = 0.0;
