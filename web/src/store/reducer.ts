@@ -41,7 +41,7 @@ export function reduce(state: State, action: Action): State {
       let missions = state.missions;
       let previousRoutes = state.previousRoutes;
       for (const m of action.missions) {
-        const merged = mergeMission(missions, previousRoutes, m, action.nowMs);
+        const merged = mergeMission(missions, previousRoutes, state.missionEventS, m, action.nowMs);
         missions = merged.missions;
         previousRoutes = merged.previousRoutes;
       }
@@ -95,7 +95,7 @@ function applySnapshot(state: State, a: Extract<Action, { type: 'snapshot' }>): 
   let missions: Record<number, Mission> = { ...state.missions };
   let previousRoutes = state.previousRoutes;
   for (const m of a.missions) {
-    const merged = mergeMission(missions, previousRoutes, m, a.nowMs);
+    const merged = mergeMission(missions, previousRoutes, state.missionEventS, m, a.nowMs);
     missions = merged.missions;
     previousRoutes = merged.previousRoutes;
   }
@@ -168,9 +168,13 @@ export function applyEvent(state: State, e: ServerEvent): State {
         last_position: { lat: e.lat, lon: e.lon },
         ...(eta !== null ? { eta_s: eta, eta_at_s: e.time_s + eta } : {}),
       });
+      next = { ...next, missionEventS: { ...next.missionEventS, [mission.id]: e.time_s } };
     }
   } else if (type === 'route_changed' && mission) {
-    if (typeof e.eta_s === 'number') next = withMission(next, { ...mission, eta_s: e.eta_s, eta_at_s: e.time_s + e.eta_s });
+    if (typeof e.eta_s === 'number') {
+      next = withMission(next, { ...mission, eta_s: e.eta_s, eta_at_s: e.time_s + e.eta_s });
+      next = { ...next, missionEventS: { ...next.missionEventS, [mission.id]: e.time_s } };
+    }
   } else if ((type === 'mission_completed' || type === 'mission_cancelled') && mission) {
     const finished: Mission = { ...mission, state: type === 'mission_completed' ? 'completed' : 'cancelled', updated_s: Math.max(mission.updated_s, e.time_s) };
     next = withMission(next, finished);
@@ -202,11 +206,18 @@ function withMission(state: State, m: Mission): State {
 function mergeMission(
   missions: Record<number, Mission>,
   previousRoutes: State['previousRoutes'],
+  missionEventS: State['missionEventS'],
   incoming: Mission,
   nowMs: number,
 ): { missions: Record<number, Mission>; previousRoutes: State['previousRoutes'] } {
   const current = missions[incoming.id];
   if (current) {
+    // A copy requested before the latest position event but answered after it: the route is
+    // current, the position and ETA the event brought are newer.
+    const eventS = missionEventS[incoming.id];
+    if (incoming.route_revision === current.route_revision && eventS !== undefined && eventS > incoming.updated_s) {
+      incoming = { ...incoming, last_position: current.last_position, eta_s: current.eta_s, eta_at_s: current.eta_at_s };
+    }
     if (incoming.route_revision < current.route_revision) return { missions, previousRoutes };
     if (incoming.route_revision === current.route_revision && incoming.updated_s < current.updated_s) return { missions, previousRoutes };
     if (current.state !== 'active' && incoming.state === 'active') return { missions, previousRoutes };

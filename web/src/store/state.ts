@@ -28,6 +28,8 @@ export interface State {
   signals: Record<number, Signal>;
   routeHistory: Record<number, RouteRevision[]>;
   previousRoutes: Record<number, FadedRoute>;
+  /** Per mission, time_s of the latest event that set its position or ETA. */
+  missionEventS: Record<number, number>;
   /** Every applied event, oldest first, capped at EVENT_LOG_LIMIT. */
   events: ServerEvent[];
   /** Highest seq applied and the time_s of that event: duplicates are dropped against them. */
@@ -76,6 +78,7 @@ export function initialState(): State {
     signals: {},
     routeHistory: {},
     previousRoutes: {},
+    missionEventS: {},
     events: [],
     lastSeq: -1,
     lastEventTimeS: -Infinity,
