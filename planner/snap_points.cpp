@@ -2,17 +2,27 @@
 
 namespace corridor::planner {
 
+NodeId node_at_snap(const maps::RoadGraph& graph, const maps::SnapResult& snap) {
+  const double len = graph.length_m(snap.edge);
+  if (snap.offset_m <= kAtNodeM) return graph.tail(snap.edge);
+  if (snap.offset_m >= len - kAtNodeM) return graph.head(snap.edge);
+  return NodeId{};
+}
+
 std::vector<EdgePoint> points_from_snap(const maps::RoadGraph& graph, const maps::SnapResult& snap, PointRole role) {
-  std::vector<EdgePoint> both{{snap.edge, snap.offset_m}};
-  if (!snap.twin.valid()) return both;
-  both.push_back({snap.twin, snap.twin_offset_m});
-  constexpr double kAtNodeM = 0.01;
-  for (std::size_t i = 0; i < 2; ++i) {
-    const double off = both[i].offset_m;
-    const double len = graph.length_m(both[i].edge);
-    const bool empty_piece = role == PointRole::goal ? off <= kAtNodeM : off >= len - kAtNodeM;
-    if (empty_piece) return {both[1 - i]};
+  if (const NodeId n = node_at_snap(graph, snap); n.valid()) {
+    std::vector<EdgePoint> at_node;
+    if (role == PointRole::start) {
+      for (EdgeId e : graph.out_edges(n)) at_node.push_back({e, 0.0});
+    } else {
+      for (EdgeId e : graph.in_edges(n)) at_node.push_back({e, graph.length_m(e)});
+    }
+    // A node with no edge in that direction (a sink or source left by a partial import) falls
+    // back to the snapped road itself.
+    if (!at_node.empty()) return at_node;
   }
+  std::vector<EdgePoint> both{{snap.edge, snap.offset_m}};
+  if (snap.twin.valid()) both.push_back({snap.twin, snap.twin_offset_m});
   return both;
 }
 

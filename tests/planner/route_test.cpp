@@ -4,6 +4,13 @@
 
 #include "planner/route_geojson.hpp"
 #include "planner/snap_points.hpp"
+#include "planner/one_to_one_search.hpp"
+#include "planner/search_space.hpp"
+#include "tests/planner/test_graphs.hpp"
+
+#include <algorithm>
+#include <queue>
+#include <random>
 #include "tests/planner/test_graphs_line.hpp"
 
 namespace corridor::planner {
@@ -63,29 +70,105 @@ TEST(Route, GeoJsonFeatureIsLonLatWithProperties) {
   EXPECT_EQ(f["properties"]["signals"].size(), 1u);
 }
 
-// A coordinate exactly on node B: as a goal it is the end of A->B (no zero-length piece of B->A),
-// as a start the beginning of B->A; mid-edge, both directions stay.
-TEST(SnapPoints, NodeCoordinatesGiveNoZeroLengthPieces) {
+// A coordinate exactly on node B: as a goal it is the end of every edge arriving at B, as a start
+// the beginning of every edge leaving it, so no zero-length piece is listed and no exit is missing;
+// mid-edge, both directions stay.
+TEST(SnapPoints, NodeCoordinatesOfferEveryEdgeAtTheNode) {
   const auto g = diamond();
   const EdgeId ab = edge_from_to(g, 1, 2), ba = edge_from_to(g, 2, 1);
+  const EdgeId bc = edge_from_to(g, 2, 3), cb = edge_from_to(g, 3, 2);
   maps::SnapResult at_b;
   at_b.edge = ab;
   at_b.offset_m = 100.0;
   at_b.twin = ba;
   at_b.twin_offset_m = 0.0;
+  auto edges_of = [](const std::vector<EdgePoint>& pts) {
+    std::vector<EdgeId> out;
+    for (const auto& p : pts) out.push_back(p.edge);
+    std::sort(out.begin(), out.end());
+    return out;
+  };
+  auto sorted = [](std::vector<EdgeId> v) {
+    std::sort(v.begin(), v.end());
+    return v;
+  };
   const auto goal = points_from_snap(g, at_b, PointRole::goal);
-  ASSERT_EQ(goal.size(), 1u);
-  EXPECT_EQ(goal[0].edge, ab);
-  EXPECT_DOUBLE_EQ(goal[0].offset_m, 100.0);
+  EXPECT_EQ(edges_of(goal), sorted({ab, cb}));
+  for (const auto& p : goal) EXPECT_DOUBLE_EQ(p.offset_m, g.length_m(p.edge));
   const auto start = points_from_snap(g, at_b, PointRole::start);
-  ASSERT_EQ(start.size(), 1u);
-  EXPECT_EQ(start[0].edge, ba);
-  EXPECT_DOUBLE_EQ(start[0].offset_m, 0.0);
+  EXPECT_EQ(edges_of(start), sorted({ba, bc}));
+  for (const auto& p : start) EXPECT_DOUBLE_EQ(p.offset_m, 0.0);
+  // Within kAtNodeM of the node is at the node; farther is mid-edge.
+  maps::SnapResult near_b = at_b;
+  near_b.offset_m = 100.0 - kAtNodeM / 2;
+  near_b.twin_offset_m = kAtNodeM / 2;
+  EXPECT_EQ(node_at_snap(g, near_b), g.head(ab));
   maps::SnapResult mid = at_b;
   mid.offset_m = 40.0;
   mid.twin_offset_m = 60.0;
+  EXPECT_FALSE(node_at_snap(g, mid).valid());
   EXPECT_EQ(points_from_snap(g, mid, PointRole::goal).size(), 2u);
   EXPECT_EQ(points_from_snap(g, mid, PointRole::start).size(), 2u);
+}
+
+// The detour the nearest-segment snap made: from a junction, a route must cost exactly the
+// node-to-node shortest path, whichever edge of the junction the snap returned. Oracle: Dijkstra
+// from the start node over graph edges, on random grids with one-way streets.
+TEST(SnapPoints, RoutesBetweenJunctionsCostTheNodeToNodeShortestPath) {
+  for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+    const auto g = testing::random_grid(seed, 8, 8);
+    const CostOverlay overlay(g);
+    const TravelCost cost(g, overlay, {30.0});
+    std::mt19937_64 rng(seed);
+    for (int trial = 0; trial < 20; ++trial) {
+      const EdgeId se{std::uniform_int_distribution<std::uint32_t>(0, static_cast<std::uint32_t>(g.edge_count() - 1))(rng)};
+      const EdgeId te{std::uniform_int_distribution<std::uint32_t>(0, static_cast<std::uint32_t>(g.edge_count() - 1))(rng)};
+      // Snap results at the head of se and at the tail of te: the edge each names is arbitrary.
+      maps::SnapResult s;
+      s.edge = se;
+      s.offset_m = g.length_m(se);
+      s.twin = g.twin(se);
+      s.twin_offset_m = 0.0;
+      maps::SnapResult t;
+      t.edge = te;
+      t.offset_m = 0.0;
+      t.twin = g.twin(te);
+      t.twin_offset_m = t.twin.valid() ? g.length_m(t.twin) : 0.0;
+      const NodeId from = g.head(se), to = g.tail(te);
+      if (from == to) continue;
+      // Node-to-node Dijkstra over transit_s, without the start node's own delay (the vehicle is
+      // already there) and with the goal node's delay excluded (it stops on arrival).
+      std::vector<double> dist(g.node_count(), kInfCost);
+      using Item = std::pair<double, std::uint32_t>;
+      std::priority_queue<Item, std::vector<Item>, std::greater<>> pq;
+      dist[from.index()] = 0.0;
+      pq.push({0.0, from.v});
+      while (!pq.empty()) {
+        const auto [d, u] = pq.top();
+        pq.pop();
+        if (d > dist[u]) continue;
+        for (EdgeId e : g.out_edges(NodeId{u})) {
+          const double w = NodeId{u} == from ? cost.edge_time_s(e) : cost.transit_s(e);
+          const double nd = d + w;
+          if (nd < dist[g.head(e).index()]) {
+            dist[g.head(e).index()] = nd;
+            pq.push({nd, g.head(e).v});
+          }
+        }
+      }
+      const SearchSpace space(cost, points_from_snap(g, s, PointRole::start), points_from_snap(g, t, PointRole::goal));
+      OneToOneSearch search;
+      const Route r = search.run(space, false);
+      if (dist[to.index()] >= kInfCost) {
+        EXPECT_FALSE(r.found);
+        continue;
+      }
+      ASSERT_TRUE(r.found);
+      EXPECT_NEAR(r.travel_time_s, dist[to.index()], 1e-6) << "seed " << seed << " trial " << trial;
+      EXPECT_EQ(g.tail(r.edges.front()), from);
+      EXPECT_EQ(g.head(r.edges.back()), to);
+    }
+  }
 }
 
 }  // namespace
