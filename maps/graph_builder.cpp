@@ -64,6 +64,7 @@ RoadGraph build_road_graph(const GraphBuildInput& in, GraphBuildReport* report) 
   std::vector<std::uint32_t> new_id(n_in, kNone);
   RoadGraphData d;
   d.origin = in.origin;
+  d.strings = in.strings;
   std::uint32_t kept = 0;
   for (std::uint32_t u = 0; u < n_in; ++u) {
     if (comps.component_of[u] != comps.largest) continue;
@@ -98,6 +99,8 @@ RoadGraph build_road_graph(const GraphBuildInput& in, GraphBuildReport* report) 
     d.edge_speed_mps.push_back(e.reversed ? seg.backward_speed_mps : seg.forward_speed_mps);
     d.edge_osm_way.push_back(seg.way);
     d.edge_class.push_back(seg.road_class);
+    d.edge_name.push_back(seg.name);
+    d.edge_ref.push_back(seg.ref);
     d.edge_twin.push_back(e.twin != kNone && new_edge[e.twin] != kNone ? EdgeId{new_edge[e.twin]} : kInvalidEdge);
     if (e.reversed) {
       for (std::uint32_t p = seg.last_point + 1; p-- > seg.first_point;) d.geometry.push_back(in.points[p]);

@@ -21,6 +21,8 @@ struct RoadSegment {
   float backward_speed_mps = 0.0f;
   OsmWayId way;
   RoadClass road_class = RoadClass::residential;
+  std::uint32_t name = 0;  // ids into GraphBuildInput::strings (0: none)
+  std::uint32_t ref = 0;
 };
 
 struct GraphBuildInput {
@@ -30,6 +32,7 @@ struct GraphBuildInput {
   std::vector<std::uint8_t> node_signalized;
   std::vector<RoadSegment> segments;
   std::vector<Point2> points;
+  StringTable strings;  // street names and refs of the segments
 };
 
 struct GraphBuildReport {

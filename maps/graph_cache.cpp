@@ -102,6 +102,10 @@ void visit_arrays(Visitor&& v, auto& d) {
   v(d.edge_osm_way);
   v(d.edge_class);
   v(d.edge_twin);
+  v(d.edge_name);
+  v(d.edge_ref);
+  v(d.strings.chars);
+  v(d.strings.first);
   v(d.geometry_first);
   v(d.geometry);
   v(d.first_in);

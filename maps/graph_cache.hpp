@@ -10,7 +10,7 @@
 
 namespace corridor::maps {
 
-inline constexpr std::uint32_t kGraphCacheVersion = 1;
+inline constexpr std::uint32_t kGraphCacheVersion = 2;  // 2: street names and refs
 
 struct CacheSource {
   std::uint64_t size_bytes = 0;

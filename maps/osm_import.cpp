@@ -23,6 +23,8 @@ struct KeptWay {
   WayRules rules;
   std::uint32_t first_ref;  // refs/locations[first_ref .. first_ref + ref_count)
   std::uint32_t ref_count;
+  std::uint32_t name;  // ids into RoadCollector::strings
+  std::uint32_t ref;
 };
 
 std::string_view tag(const osmium::TagList& tags, const char* key) {
@@ -58,7 +60,8 @@ class RoadCollector : public osmium::handler::Handler {
     const auto rules = interpret_way(wt);
     if (!rules || way.nodes().size() < 2) return;
     ways.push_back({OsmWayId{way.id()}, *rules, static_cast<std::uint32_t>(refs.size()),
-                    static_cast<std::uint32_t>(way.nodes().size())});
+                    static_cast<std::uint32_t>(way.nodes().size()), strings.intern(tag(t, "name")),
+                    strings.intern(tag(t, "ref"))});
     for (const auto& nr : way.nodes()) {
       refs.push_back(nr.ref());
       locations.push_back(nr.location());  // invalid when the extract cut the node off
@@ -70,6 +73,7 @@ class RoadCollector : public osmium::handler::Handler {
   std::vector<osmium::object_id_type> refs;
   std::vector<osmium::Location> locations;
   std::vector<osmium::object_id_type> signals;
+  StringInterner strings;
 };
 
 using LocationIndex = osmium::index::map::FlexMem<osmium::unsigned_object_id_type, osmium::Location>;
@@ -127,6 +131,7 @@ RoadGraph import_osm(const std::filesystem::path& path, const OsmImportOptions& 
     if (loc.valid()) box.extend(loc);
   }
   GraphBuildInput in;
+  in.strings = c.strings.take();
   in.origin = {(box.bottom_left().lat() + box.top_right().lat()) / 2.0,
                (box.bottom_left().lon() + box.top_right().lon()) / 2.0};
   const LocalProjection projection(in.origin);
@@ -186,6 +191,8 @@ RoadGraph import_osm(const std::filesystem::path& path, const OsmImportOptions& 
           seg.backward_speed_mps = static_cast<float>(way.rules.backward_speed_kmh * kKmhToMps);
           seg.way = way.id;
           seg.road_class = way.rules.road_class;
+          seg.name = way.name;
+          seg.ref = way.ref;
           in.segments.push_back(seg);
           for (const auto& [ref_i, d] : interior_signals) {
             const double to_end = along - d;

@@ -25,6 +25,15 @@ void validate(const RoadGraphData& d) {
               d.edge_osm_way.size() == m && d.edge_class.size() == m && d.edge_twin.size() == m &&
               d.in_edge.size() == m && d.geometry_first.size() == m + 1,
           "edge arrays differ in length");
+  require(d.edge_name.size() == m && d.edge_ref.size() == m, "name arrays differ in length");
+  require(!d.strings.first.empty() && d.strings.first.front() == 0 && d.strings.first.back() == d.strings.chars.size(),
+          "string table offsets do not cover its characters");
+  for (std::size_t i = 0; i + 1 < d.strings.first.size(); ++i) {
+    require(d.strings.first[i] <= d.strings.first[i + 1], "string table offsets decrease");
+  }
+  for (std::size_t e = 0; e < m; ++e) {
+    require(d.edge_name[e] < d.strings.size() && d.edge_ref[e] < d.strings.size(), "edge name id out of range");
+  }
   require(d.first_out.front() == 0 && d.first_out.back() == m, "forward CSR does not cover all edges");
   require(d.first_in.front() == 0 && d.first_in.back() == m, "reverse CSR does not cover all edges");
   require(d.geometry_first.front() == 0 && d.geometry_first.back() == d.geometry.size(),
@@ -62,6 +71,9 @@ void build_reverse_adjacency(RoadGraphData& d) {
 }
 
 RoadGraph::RoadGraph(RoadGraphData data) : data_(std::move(data)), projection_(data_.origin) {
+  if (data_.edge_name.empty()) data_.edge_name.assign(data_.edge_head.size(), 0);
+  if (data_.edge_ref.empty()) data_.edge_ref.assign(data_.edge_head.size(), 0);
+  if (data_.strings.first.empty()) data_.strings.first = {0, 0};
   validate(data_);
   double scale = 1.0;
   for (std::size_t e = 0; e < edge_count(); ++e) {

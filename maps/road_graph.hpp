@@ -10,6 +10,7 @@
 #include "maps/geo.hpp"
 #include "maps/ids.hpp"
 #include "maps/road_class.hpp"
+#include "maps/string_table.hpp"
 
 namespace corridor::maps {
 
@@ -32,6 +33,11 @@ struct RoadGraphData {
   std::vector<OsmWayId> edge_osm_way;
   std::vector<RoadClass> edge_class;
   std::vector<EdgeId> edge_twin;  // the same road in the opposite direction, or invalid
+  // OSM `name` and `ref` of the edge's way, as ids into `strings` (0: none). May be left empty by a
+  // builder that has no names (synthetic grids); the graph then fills them with 0.
+  std::vector<std::uint32_t> edge_name;
+  std::vector<std::uint32_t> edge_ref;
+  StringTable strings;
 
   // Geometry: edge e's polyline is geometry[geometry_first[e] .. geometry_first[e+1]), tail to head.
   std::vector<std::uint32_t> geometry_first;
@@ -66,6 +72,9 @@ class RoadGraph {
   [[nodiscard]] OsmWayId osm_way(EdgeId e) const { return data_.edge_osm_way[e.index()]; }
   [[nodiscard]] RoadClass road_class(EdgeId e) const { return data_.edge_class[e.index()]; }
   [[nodiscard]] EdgeId twin(EdgeId e) const { return data_.edge_twin[e.index()]; }
+  // The street's OSM name and ref ("" when the way has none).
+  [[nodiscard]] std::string_view name(EdgeId e) const { return data_.strings.at(data_.edge_name[e.index()]); }
+  [[nodiscard]] std::string_view ref(EdgeId e) const { return data_.strings.at(data_.edge_ref[e.index()]); }
   [[nodiscard]] std::span<const Point2> geometry(EdgeId e) const {
     const auto b = data_.geometry_first[e.index()];
     return {data_.geometry.data() + b, data_.geometry_first[e.index() + 1] - b};
