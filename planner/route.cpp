@@ -62,9 +62,12 @@ std::vector<maps::Point2> edge_polyline(const maps::RoadGraph& graph, EdgeId e, 
   return out;
 }
 
-std::vector<maps::Point2> route_polyline(const maps::RoadGraph& graph, const Route& route) {
+std::vector<maps::Point2> route_polyline(const maps::RoadGraph& graph, const Route& route,
+                                         std::vector<std::uint32_t>* edge_first) {
   std::vector<maps::Point2> out;
+  if (edge_first != nullptr) edge_first->clear();
   for (std::size_t i = 0; i < route.edges.size(); ++i) {
+    if (edge_first != nullptr) edge_first->push_back(static_cast<std::uint32_t>(out.empty() ? 0 : out.size() - 1));
     const EdgeId e = route.edges[i];
     const double from = i == 0 ? route.start.offset_m : 0.0;
     const double to = i + 1 == route.edges.size() ? route.goal.offset_m : graph.length_m(e);

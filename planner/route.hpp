@@ -28,8 +28,10 @@ struct Route {
 // Evaluates driving `edges` (first = start.edge, last = goal.edge) under the current costs.
 Route make_route(const TravelCost& cost, EdgePoint start, std::vector<EdgeId> edges, EdgePoint goal);
 
-// The route's polyline in the local frame, clipped at the start and goal offsets.
-std::vector<maps::Point2> route_polyline(const maps::RoadGraph& graph, const Route& route);
+// The route's polyline in the local frame, clipped at the start and goal offsets. With
+// `edge_first`, also where each edge's piece starts in it (consecutive pieces share their junction).
+std::vector<maps::Point2> route_polyline(const maps::RoadGraph& graph, const Route& route,
+                                         std::vector<std::uint32_t>* edge_first = nullptr);
 
 // The part of edge e between two offsets, as a polyline.
 std::vector<maps::Point2> edge_polyline(const maps::RoadGraph& graph, EdgeId e, double from_m, double to_m);

@@ -1,0 +1,41 @@
+// Turn-by-turn steps of a route, as OSRM's `steps` give them: one step per stretch of one street,
+// with its distance, duration and the maneuver that starts it.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "planner/route.hpp"
+
+namespace corridor::planner {
+
+enum class ManeuverType { depart, turn, new_name, continue_on, arrive };
+enum class TurnModifier { none, uturn, sharp_right, right, slight_right, straight, slight_left, left, sharp_left };
+
+const char* to_string(ManeuverType t);    // OSRM's words: "depart", "turn", "new name", "continue", "arrive"
+const char* to_string(TurnModifier m);    // "uturn", "sharp right", ..., or "" for none
+
+struct RouteStep {
+  std::string name;  // the street driven during the step ("" when unnamed)
+  std::string ref;
+  double distance_m = 0;
+  double duration_s = 0;
+  ManeuverType maneuver = ManeuverType::depart;
+  TurnModifier modifier = TurnModifier::none;
+  maps::Point2 location;  // where the maneuver happens
+  double turn_deg = 0;    // signed turn angle at the maneuver, right positive
+};
+
+struct StepOptions {
+  // A turn at least this sharp starts a new step even when the street's name does not change.
+  double continue_turn_deg = 45.0;
+};
+
+// The modifier for a signed turn angle (right positive, degrees in (-180, 180]).
+TurnModifier modifier_for_turn(double turn_deg);
+
+// Depart, one step per street (or per sharp turn on one street), arrive. Empty for a route not found.
+std::vector<RouteStep> route_steps(const maps::RoadGraph& graph, const Route& route, const StepOptions& options = {});
+
+}  // namespace corridor::planner
