@@ -41,44 +41,47 @@ const api = new ApiClient('');
 let map: L.Map | null = null;
 let renders = 0;
 
-const hook: TestHook = {
-  mapReadyMs: null,
-  mapFeatures: 0,
+const timings = { mapReadyMs: null as number | null, mapFeatures: 0 };
+let frames = 0;
+let framesFrom = 0;
+let rendersFrom = 0;
+let counting = false;
+const countFrames = () => {
+  if (!counting) return;
+  frames++;
+  requestAnimationFrame(countFrames);
+};
+const hook: TestHook = Object.freeze({
+  get mapReadyMs() {
+    return timings.mapReadyMs;
+  },
+  get mapFeatures() {
+    return timings.mapFeatures;
+  },
   state: () => store.getState(),
-  pagePoint: (lat, lon) => {
+  pagePoint: (lat: number, lon: number) => {
     if (!map) return null;
     const p = map.latLngToContainerPoint([lat, lon]);
     const r = map.getContainer().getBoundingClientRect();
     return { x: r.left + p.x, y: r.top + p.y };
   },
-  fps: (() => {
-    let frames = 0;
-    let startRenders = 0;
-    let t0 = 0;
-    let running = false;
-    const loop = () => {
-      if (!running) return;
-      frames++;
-      requestAnimationFrame(loop);
-    };
-    return {
-      start: () => {
-        frames = 0;
-        startRenders = renders;
-        t0 = performance.now();
-        running = true;
-        requestAnimationFrame(loop);
-      },
-      stop: () => {
-        running = false;
-        const seconds = (performance.now() - t0) / 1000;
-        const r = renders - startRenders;
-        return { frames, renders: r, seconds, fps: frames / seconds, renders_per_s: r / seconds };
-      },
-    };
-  })(),
-};
-window.__corridor = Object.freeze(hook) as TestHook;
+  fps: Object.freeze({
+    start: () => {
+      frames = 0;
+      rendersFrom = renders;
+      framesFrom = performance.now();
+      counting = true;
+      requestAnimationFrame(countFrames);
+    },
+    stop: () => {
+      counting = false;
+      const seconds = (performance.now() - framesFrom) / 1000;
+      const r = renders - rendersFrom;
+      return { frames, renders: r, seconds, fps: frames / seconds, renders_per_s: r / seconds };
+    },
+  }),
+});
+window.__corridor = hook;
 
 function signOut(): void {
   forgetToken();
@@ -105,7 +108,7 @@ async function signIn(token: string): Promise<void> {
 
 async function start(me: Me): Promise<void> {
   const t0 = performance.now();
-  map = L.map('map', { preferCanvas: true, zoomControl: true, attributionControl: true, minZoom: 3, maxZoom: 19 });
+  map = L.map('map', { preferCanvas: true, zoomSnap: 0.25, zoomControl: true, attributionControl: true, minZoom: 3, maxZoom: 19 });
   map.attributionControl.setPrefix('<a href="https://leafletjs.com">Leaflet</a>');
   const fc = await api.map().catch((e: Error) => {
     byTestId('connection-status').textContent = `map: ${e.message}`;
@@ -119,10 +122,10 @@ async function start(me: Me): Promise<void> {
   const base: BaseMap = createBaseMap(map, fc);
   map.attributionControl.addAttribution(escapeHtml(base.attribution));
   map.attributionControl.getContainer()?.setAttribute('data-testid', 'attribution');
-  hook.mapFeatures = fc.features.length;
+  timings.mapFeatures = fc.features.length;
   addLegend(map);
   requestAnimationFrame(() => {
-    hook.mapReadyMs = performance.now() - t0;
+    timings.mapReadyMs = performance.now() - t0;
     byTestId('map').dataset.ready = 'true';
   });
 
@@ -142,7 +145,9 @@ async function start(me: Me): Promise<void> {
     void sync.refreshRoutes(id);
     void sync.refreshMission(id);
   };
-  routes.onRouteClick(select);
+  vehicles.onClick((v) => {
+    if (v.mission !== null && v.mission !== undefined) select(v.mission);
+  });
 
   const roles = new Set(me.roles);
   const mode: ClickMode = { current: 'destination' };
@@ -190,6 +195,7 @@ function addLegend(m: L.Map): void {
   legend.onAdd = () => {
     const div = L.DomUtil.create('div', 'legend');
     div.setAttribute('data-testid', 'legend');
+    L.DomUtil.create('strong', '', div).textContent = 'Route';
     for (const [cls, text] of [
       ['free', 'free flow'],
       ['slow', 'slow (≤2×)'],

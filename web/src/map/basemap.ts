@@ -11,14 +11,14 @@ interface ClassStyle {
 }
 
 const CLASS_STYLE: Record<string, ClassStyle> = {
-  motorway: { color: '#e8927c', weight: 4 },
-  motorway_link: { color: '#e8927c', weight: 2.5 },
-  trunk: { color: '#f9b29c', weight: 4 },
-  trunk_link: { color: '#f9b29c', weight: 2.5 },
-  primary: { color: '#f7c77a', weight: 3.5 },
-  primary_link: { color: '#f7c77a', weight: 2.5 },
-  secondary: { color: '#e3d85c', weight: 3 },
-  secondary_link: { color: '#e3d85c', weight: 2 },
+  motorway: { color: '#d9a3a3', weight: 4 },
+  motorway_link: { color: '#d9a3a3', weight: 2.5 },
+  trunk: { color: '#e3b5a8', weight: 4 },
+  trunk_link: { color: '#e3b5a8', weight: 2.5 },
+  primary: { color: '#e8cfa6', weight: 3.5 },
+  primary_link: { color: '#e8cfa6', weight: 2.5 },
+  secondary: { color: '#e3dfb0', weight: 3 },
+  secondary_link: { color: '#e3dfb0', weight: 2 },
   tertiary: { color: '#c9c9a0', weight: 2.5 },
   tertiary_link: { color: '#c9c9a0', weight: 2 },
   residential: { color: '#a9a9a9', weight: 1.8 },

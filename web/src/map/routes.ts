@@ -33,17 +33,19 @@ export function scheduleText(e: ScheduleEntry): string {
 }
 
 export class RouteLayers {
-  private readonly renderer = L.canvas({ padding: 0.3 });
+  private readonly renderer: L.Canvas;
   private readonly layers = new Map<number, MissionLayers>();
   private readonly root = L.layerGroup();
-  private readonly clickHandlers: ((mission: number) => void)[] = [];
 
   constructor(map: L.Map) {
+    // Routes have their own canvas, so a route update does not redraw the road graph. Only the
+    // top canvas of a stack gets mouse events: this one is in a pane that lets them through to
+    // the roads below (clicks on a road pick it for congestion or as a destination).
+    const pane = map.createPane('routes');
+    pane.style.zIndex = '420';
+    pane.style.pointerEvents = 'none';
+    this.renderer = L.canvas({ padding: 0.3, pane: 'routes' });
     this.root.addTo(map);
-  }
-
-  onRouteClick(handler: (mission: number) => void): void {
-    this.clickHandlers.push(handler);
   }
 
   update(state: State, previous: State | null): void {
@@ -67,14 +69,19 @@ export class RouteLayers {
 
   private create(id: number): MissionLayers {
     const group = L.layerGroup().addTo(this.root);
-    const faded = L.polyline([], { renderer: this.renderer, color: '#5c6bc0', weight: 5, opacity: 0.35, dashArray: '6 6', interactive: false }).addTo(group);
+    const faded = L.polyline([], { renderer: this.renderer, pane: 'routes', color: '#5c6bc0', weight: 5, opacity: 0.35, dashArray: '6 6', interactive: false }).addTo(group);
     const lines = {} as Record<CongestionBucket, L.Polyline>;
     for (const b of BUCKETS) {
-      lines[b] = L.polyline([], { renderer: this.renderer, color: BUCKET_COLOR[b], weight: 5, opacity: 0.9, lineCap: 'round', lineJoin: 'round' }).addTo(group);
-      lines[b].on('click', (e) => {
-        L.DomEvent.stopPropagation(e);
-        for (const h of this.clickHandlers) h(id);
-      });
+      lines[b] = L.polyline([], {
+        renderer: this.renderer,
+        pane: 'routes',
+        color: BUCKET_COLOR[b],
+        weight: 5,
+        opacity: 0.9,
+        lineCap: 'round',
+        lineJoin: 'round',
+        interactive: false,
+      }).addTo(group);
     }
     const destination = L.marker([0, 0], {
       icon: L.divIcon({ className: 'pin-icon', html: '<div class="pin mission-destination"></div>', iconSize: [10, 10], iconAnchor: [1, 12] }),
@@ -112,6 +119,7 @@ export class RouteLayers {
           icon: L.divIcon({ className: 'schedule-icon', html: '<div class="schedule-marker"></div>', iconSize: [8, 8] }),
           keyboard: false,
           zIndexOffset: 500,
+          bubblingMouseEvents: true,
         }).addTo(layers.group);
         s = { marker, text: '', permanent: false, state: '' };
         layers.schedule.set(e.signal, s);
@@ -119,7 +127,6 @@ export class RouteLayers {
       if (s.text !== text || s.permanent !== selected) {
         s.marker.unbindTooltip();
         s.marker.bindTooltip(selected ? `${clockTime(e.arrival_s)}` : text, { permanent: selected, direction: 'right', className: 'arrival', offset: L.point(6, 0) });
-        if (selected) s.marker.getTooltip()?.setContent(`${clockTime(e.arrival_s)}`);
         s.text = text;
         s.permanent = selected;
       }

@@ -34,6 +34,7 @@ export class SignalLayer {
           icon: L.divIcon({ className: 'signal-icon', html: '<div class="signal-marker"></div>', iconSize: [10, 10], iconAnchor: [5, 5] }),
           keyboard: false,
           zIndexOffset: 200,
+          bubblingMouseEvents: true,
         }).addTo(this.group);
         marker.getElement()?.setAttribute('data-testid', `signal-${s.id}`);
         sm = { marker, signal: null };

@@ -13,9 +13,15 @@ interface VehicleMarker {
 export class VehicleLayer {
   private readonly markers = new Map<string, VehicleMarker>();
   private readonly group = L.layerGroup();
+  private readonly clickHandlers: ((vehicle: Vehicle) => void)[] = [];
 
   constructor(map: L.Map) {
     this.group.addTo(map);
+  }
+
+  /** A click on a vehicle (the console selects its mission). */
+  onClick(handler: (vehicle: Vehicle) => void): void {
+    this.clickHandlers.push(handler);
   }
 
   update(state: State, previous: State | null): void {
@@ -34,6 +40,10 @@ export class VehicleLayer {
           keyboard: false,
           zIndexOffset: 1000,
         }).addTo(this.group);
+        marker.on('click', () => {
+          const latest = this.markers.get(v.vehicle_id)?.vehicle;
+          if (latest) for (const h of this.clickHandlers) h(latest);
+        });
         const el = marker.getElement();
         if (el) {
           el.setAttribute('data-testid', `vehicle-${v.vehicle_id}`);
