@@ -372,6 +372,13 @@ std::vector<PreemptionEvent> PreemptionEngine::take_events() {
   return out;
 }
 
+bool PreemptionEngine::planned(NodeId node) const {
+  auto it = nodes_.find(node);
+  if (it == nodes_.end()) return false;
+  return std::any_of(it->second.entries.begin(), it->second.entries.end(),
+                     [](const ScheduleEntry* e) { return e->state == EntryState::planned; });
+}
+
 bool PreemptionEngine::holding(NodeId node) const {
   auto it = nodes_.find(node);
   return it != nodes_.end() && !it->second.held.empty();

@@ -102,6 +102,8 @@ class PreemptionEngine {
   [[nodiscard]] std::vector<ScheduleEntry> schedule(MissionId mission) const;
   [[nodiscard]] std::vector<PreemptionEvent> take_events();
   [[nodiscard]] bool holding(NodeId node) const;
+  // True when a live entry of some mission plans a hold at the node that has not started yet.
+  [[nodiscard]] bool planned(NodeId node) const;
 
  private:
   struct NodeState {

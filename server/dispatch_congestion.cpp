@@ -86,7 +86,12 @@ CongestionResult DispatchService::report_congestion(const std::vector<Congestion
     if (expiry[i]) expiries_.emplace(*expiry[i], std::make_pair(changes[i].first, seq));
   }
   const std::vector<MissionPtr> affected = apply_changes(changes, "congestion");
-  emit("congestion_applied", 0, std::to_string(changes.size()) + " edges", now_s);
+  DispatchEvent applied;
+  applied.kind = "congestion_applied";
+  applied.reason = std::to_string(changes.size()) + " edges";
+  applied.time_s = now_s;
+  applied.edges_changed = changes.size();
+  emit(std::move(applied));
   std::vector<std::shared_ptr<CommitTicket>> durable;
   CongestionResult result = repair_plans(affected, now_s, started, durable);
   result.edges_changed = changes.size();
@@ -201,6 +206,8 @@ void DispatchService::tick(double now_s) {
     signals_.advance(now_s);
     preemption_.tick(now_s);
     drain_preemption_events(staged);
+    // Recovery ends inside the signals' own clock, without an engine event.
+    for (const auto& [node, plan] : plans_) announce_signal_state(node, now_s);
   }
   submit(staged);
 }

@@ -23,6 +23,14 @@ struct DispatchService::Mission {
   planner::Route route;
   std::uint32_t revision = 0;
   std::vector<preemption::ScheduleEntry> final_schedule;  // kept when the engine forgets the mission
+  double route_time_s = 0;  // when `route` was last computed
+  // Route revisions, oldest first: what was stored (restored from the store after a restart, with
+  // its geometry) and, for revisions made in this process, the route, rendered when asked for.
+  struct Revision {
+    RouteRevisionView view;
+    std::optional<planner::Route> route;
+  };
+  std::vector<Revision> history;
 
   // Edges whose cost changed since the planner last heard, and the reason to give if the repaired
   // route differs. Appended under the overlay's exclusive lock, taken under its shared lock, so a

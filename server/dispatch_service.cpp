@@ -117,19 +117,102 @@ void DispatchService::unsubscribe(std::size_t id) {
 }
 
 void DispatchService::emit(const std::string& kind, MissionId mission, const std::string& reason, double now_s) {
-  const DispatchEvent event{kind, mission, reason, now_s};
+  DispatchEvent event;
+  event.kind = kind;
+  event.mission = mission;
+  event.reason = reason;
+  event.time_s = now_s;
+  emit(std::move(event));
+}
+
+void DispatchService::emit(DispatchEvent event) {
   std::lock_guard lock(listeners_mutex_);
+  // Numbered under the lock that orders delivery, so every listener sees seq increasing.
+  event.seq = next_event_seq_++;
   for (const auto& [id, l] : listeners_) l(event);
+}
+
+std::string DispatchService::signal_state_locked(NodeId node) const {
+  if (signals_.mode(node) == preemption::SignalMode::held) return "held";
+  // The program passes through yellow and all-red between its own steps too; it is recovering
+  // only on its way back from a hold, until its own phase is on show again.
+  if (!signals_.running_program(node)) {
+    auto it = shown_signal_state_.find(node);
+    if (it != shown_signal_state_.end() && (it->second == "held" || it->second == "recovering")) return "recovering";
+  }
+  if (preemption_.planned(node)) return "scheduled";
+  return "normal";
+}
+
+std::string DispatchService::signal_state(NodeId node) const {
+  if (plans_.count(node) == 0) throw not_found("no signal at node " + std::to_string(node.v));
+  std::lock_guard lock(preemption_mutex_);
+  return signal_state_locked(node);
+}
+
+void DispatchService::announce_signal_state(NodeId node, double now_s) {
+  if (plans_.count(node) == 0) return;
+  std::string state = signal_state_locked(node);
+  auto [it, fresh] = shown_signal_state_.try_emplace(node, "normal");
+  if (it->second == state) return;
+  it->second = state;
+  DispatchEvent e;
+  e.kind = "signal_state";
+  e.signal = node;
+  e.state = std::move(state);
+  e.time_s = now_s;
+  emit(std::move(e));
+}
+
+std::vector<VehicleView> DispatchService::vehicles() const {
+  std::vector<VehicleView> out;
+  std::shared_lock lock(registry_mutex_);
+  out.reserve(vehicles_.size());
+  for (const auto& [id, v] : vehicles_) {
+    out.push_back(v);
+    if (auto it = active_by_vehicle_.find(id); it != active_by_vehicle_.end()) out.back().mission = it->second;
+  }
+  std::sort(out.begin(), out.end(), [](const VehicleView& a, const VehicleView& b) { return a.vehicle_id < b.vehicle_id; });
+  return out;
+}
+
+std::vector<RouteRevisionView> DispatchService::route_history(MissionId id) const {
+  MissionPtr m;
+  {
+    std::shared_lock lock(registry_mutex_);
+    auto it = missions_.find(id);
+    if (it == missions_.end()) throw not_found("no mission " + std::to_string(id));
+    m = it->second;
+  }
+  std::vector<Mission::Revision> history;
+  {
+    std::lock_guard lock(m->mutex);
+    history = m->history;
+  }
+  // Rendered outside the mission's lock: the routes are copies.
+  std::vector<RouteRevisionView> out;
+  out.reserve(history.size());
+  for (auto& r : history) {
+    if (r.view.geometry_json.empty() && r.route) {
+      r.view.geometry_json = planner::route_to_geojson(graph_, *r.route, "dstar")["geometry"].dump();
+    }
+    out.push_back(std::move(r.view));
+  }
+  return out;
 }
 
 std::vector<planner::EdgePoint> DispatchService::endpoints(const maps::SnapResult& s, Role role,
                                                            std::optional<double> heading) const {
   auto points = planner::points_from_snap(graph_, s, role == Role::goal ? planner::PointRole::goal : planner::PointRole::start);
   if (!heading || points.size() == 1) return points;
-  // A heading picks the direction of travel on a two-way street.
-  const double a = angle_between_deg(bearing_deg(graph_, points[0].edge, points[0].offset_m), *heading);
-  const double b = angle_between_deg(bearing_deg(graph_, points[1].edge, points[1].offset_m), *heading);
-  return {a <= b ? points[0] : points[1]};
+  // A heading picks the direction of travel on a two-way street, or the exit at a junction.
+  std::size_t best = 0;
+  double best_deg = 360.0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const double d = angle_between_deg(bearing_deg(graph_, points[i].edge, points[i].offset_m), *heading);
+    if (d < best_deg) best = i, best_deg = d;
+  }
+  return {points[best]};
 }
 
 MissionView DispatchService::view(const Mission& m) const {
@@ -143,6 +226,12 @@ MissionView DispatchService::view(const Mission& m) const {
   v.last_position = m.last_position;
   v.route = m.route;
   v.route_revision = m.revision;
+  v.route_time_s = m.route_time_s;
+  if (m.row.state == MissionState::active) {
+    std::shared_lock costs(overlay_mutex_);
+    v.congestion_factors.reserve(m.route.edges.size());
+    for (EdgeId e : m.route.edges) v.congestion_factors.push_back(overlay_.edge(e).congestion_factor);
+  }
   if (m.row.state == MissionState::active) {
     std::lock_guard lock(preemption_mutex_);
     v.schedule = preemption_.schedule(m.row.id);
@@ -155,10 +244,20 @@ MissionView DispatchService::view(const Mission& m) const {
 }
 
 void DispatchService::drain_preemption_events(Staged& staged) {
+  std::vector<std::pair<NodeId, double>> touched;
   for (const auto& e : preemption_.take_events()) {
     stage(staged, [e](Store& store) { store.insert_preemption_event(e); });
-    emit("preemption_" + e.kind, e.mission, e.detail, e.time_s);
+    DispatchEvent out;
+    out.kind = "preemption_" + e.kind;
+    out.mission = e.mission;
+    out.reason = e.detail;
+    out.time_s = e.time_s;
+    out.signal = e.node;
+    emit(std::move(out));
+    touched.emplace_back(e.node, e.time_s);
   }
+  // The signals these events touched may have changed state; the tick looks at all of them.
+  for (const auto& [node, time_s] : touched) announce_signal_state(node, time_s);
 }
 
 std::optional<std::string> DispatchService::repair(Mission& m, const std::vector<planner::EdgePoint>* new_start) {
@@ -186,6 +285,10 @@ void DispatchService::persist_route(Mission& m, const std::string& reason, doubl
   });
   ++m.revision;
   m.row.updated_s = now_s;
+  m.history.push_back({{m.revision, reason, now_s, m.route.travel_time_s, m.route.length_m, {}}, m.route});
+  // A mission that keeps changing its route keeps its latest revisions; the store keeps all.
+  constexpr std::size_t kHistoryKept = 200;
+  if (m.history.size() > kHistoryKept) m.history.erase(m.history.begin());
 }
 
 void DispatchService::retime_signals(Mission& m, double now_s, Staged& staged) {
@@ -196,7 +299,15 @@ void DispatchService::retime_signals(Mission& m, double now_s, Staged& staged) {
 }
 
 void DispatchService::announce_route(Mission& m, const std::string& reason, double now_s, Staged& staged) {
-  emit(m.revision == 1 ? "mission_created" : "route_changed", m.row.id, reason, now_s);
+  DispatchEvent e;
+  e.kind = m.revision == 1 ? "mission_created" : "route_changed";
+  e.mission = m.row.id;
+  e.reason = reason;
+  e.time_s = now_s;
+  e.vehicle_id = m.row.vehicle_id;
+  e.revision = m.revision;
+  if (m.route.found) e.eta_s = m.route.travel_time_s;
+  emit(std::move(e));
   retime_signals(m, now_s, staged);
 }
 
@@ -211,6 +322,7 @@ MissionView DispatchService::create_mission(const MissionRequest& req, double no
   if (req.priority < 0 || req.priority > 10) throw bad_request("priority must be between 0 and 10");
   std::lock_guard creating(create_mutex_);
   std::optional<maps::LatLon> origin = req.origin;
+  std::optional<double> origin_heading;  // a vehicle's own position says which way it faces
   {
     std::shared_lock lock(registry_mutex_);
     if (active_by_vehicle_.count(req.vehicle_id) != 0) {
@@ -218,7 +330,10 @@ MissionView DispatchService::create_mission(const MissionRequest& req, double no
                      std::to_string(active_by_vehicle_.at(req.vehicle_id)) + "; cancel it first");
     }
     if (!origin) {
-      if (auto it = last_position_.find(req.vehicle_id); it != last_position_.end()) origin = it->second;
+      if (auto it = vehicles_.find(req.vehicle_id); it != vehicles_.end()) {
+        origin = it->second.position;
+        origin_heading = it->second.heading_deg;
+      }
     }
   }
   if (!origin) {
@@ -247,10 +362,11 @@ MissionView DispatchService::create_mission(const MissionRequest& req, double no
   {
     // Planned and registered under one view of the costs, so no congestion change falls between.
     std::shared_lock costs(overlay_mutex_);
-    m->planner = std::make_unique<planner::DStarLite>(*m->cost, endpoints(from, Role::start, std::nullopt),
+    m->planner = std::make_unique<planner::DStarLite>(*m->cost, endpoints(from, Role::start, origin_heading),
                                                       endpoints(to, Role::goal, std::nullopt));
     m->planner->replan();
     m->route = m->planner->route();
+    m->route_time_s = now_s;
     if (!m->route.found) throw unprocessable("unreachable", "the destination cannot be reached from the origin");
     stage(staged, [row = m->row](Store& store) { store.insert_mission(row); });
     persist_route(*m, "dispatch", now_s, staged);
@@ -327,7 +443,12 @@ void DispatchService::finish(Mission& m, MissionState state, double now_s, Stage
     std::lock_guard lock(registry_mutex_);
     active_by_vehicle_.erase(m.row.vehicle_id);
   }
-  emit(state == MissionState::completed ? "mission_completed" : "mission_cancelled", m.row.id, "", now_s);
+  DispatchEvent e;
+  e.kind = state == MissionState::completed ? "mission_completed" : "mission_cancelled";
+  e.mission = m.row.id;
+  e.time_s = now_s;
+  e.vehicle_id = m.row.vehicle_id;
+  emit(std::move(e));
 }
 
 MissionView DispatchService::cancel_mission(MissionId id, double now_s) {
@@ -369,7 +490,8 @@ PositionResult DispatchService::report_position(const PositionReport& p, double 
   MissionPtr mp;
   {
     std::lock_guard lock(registry_mutex_);
-    last_position_[p.vehicle_id] = p.position;
+    VehicleView& v = vehicles_[p.vehicle_id];
+    v = {p.vehicle_id, p.position, p.heading_deg, p.speed_mps, p.timestamp_s, p.source, std::nullopt};
     if (auto it = active_by_vehicle_.find(p.vehicle_id); it != active_by_vehicle_.end()) mp = missions_.at(it->second);
   }
   Staged staged;
@@ -403,7 +525,19 @@ PositionResult DispatchService::report_position(const PositionReport& p, double 
   // This repair also covers any cost change the planner heard of since its last one.
   const std::string reason = repair(m, &points).value_or("off_route");
   result.eta_s = m.route.travel_time_s;
-  emit("position", m.row.id, p.source, now_s);
+  m.route_time_s = now_s;
+  DispatchEvent moved;
+  moved.kind = "position";
+  moved.mission = m.row.id;
+  moved.reason = p.source;
+  moved.time_s = now_s;
+  moved.vehicle_id = p.vehicle_id;
+  moved.position = p.position;
+  moved.heading_deg = p.heading_deg;
+  moved.speed_mps = p.speed_mps;
+  moved.source = p.source;
+  if (m.route.found) moved.eta_s = m.route.travel_time_s;
+  emit(std::move(moved));
   if (!m.route.found || m.route.length_m <= config_.arrival_radius_m ||
       maps::distance_m(snap.point, m.destination_local) <= config_.arrival_radius_m) {
     result.completed = true;
@@ -455,6 +589,11 @@ std::size_t DispatchService::active_mission_count() const {
 
 // Runs in the constructor, before the service is shared: no locks needed.
 void DispatchService::restore(double now_s) {
+  const auto restored_history = [this](MissionId id) {
+    std::vector<Mission::Revision> out;
+    for (RouteRevisionView& v : store_->route_revisions(id)) out.push_back({std::move(v), std::nullopt});
+    return out;
+  };
   for (const CongestionRow& c : store_->congestion_in_force(now_s)) {
     if (c.edge.index() >= graph_.edge_count()) continue;  // recorded against another map
     overlay_.set_edge(c.edge, c.condition);
@@ -471,6 +610,8 @@ void DispatchService::restore(double now_s) {
       auto m = std::make_shared<Mission>();
       m->row = row;
       if (last) m->last_position = last->position;
+      m->history = restored_history(row.id);
+      m->revision = m->history.empty() ? 0 : m->history.back().view.revision;
       missions_[row.id] = std::move(m);
       continue;
     }
@@ -488,9 +629,13 @@ void DispatchService::restore(double now_s) {
           endpoints(to, Role::goal, std::nullopt));
       m->planner->replan();
       m->route = m->planner->route();
+      m->route_time_s = now_s;
+      m->history = restored_history(row.id);
+      m->revision = m->history.empty() ? 0 : m->history.back().view.revision;
       missions_[row.id] = m;
       active_by_vehicle_[row.vehicle_id] = row.id;
-      last_position_[row.vehicle_id] = start;
+      vehicles_[row.vehicle_id] = {row.vehicle_id, start, last ? last->heading_deg : std::nullopt, std::nullopt,
+                                   last ? last->timestamp_s : now_s, "gps", std::nullopt};
       publish_route(*m, "restart", now_s, staged);
       spdlog::info("event=mission_resumed mission={} vehicle={}", row.id, row.vehicle_id);
     } catch (const maps::SnapError& e) {

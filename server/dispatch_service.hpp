@@ -76,6 +76,13 @@ class DispatchService {
   // "program", and the program step; a simulator mirrors these onto its own lights.
   [[nodiscard]] std::pair<std::string, std::size_t> signal_mode(NodeId node) const;
   [[nodiscard]] std::size_t active_mission_count() const;
+  // What a console shows of a signal: "normal" (its program), "scheduled" (a hold is planned),
+  // "held" (green for an emergency vehicle) or "recovering" (yellow and all-red back to the program).
+  [[nodiscard]] std::string signal_state(NodeId node) const;
+  // Every vehicle's latest accepted report, by vehicle id.
+  [[nodiscard]] std::vector<VehicleView> vehicles() const;
+  // The mission's route revisions, oldest first (404 for an unknown mission).
+  [[nodiscard]] std::vector<RouteRevisionView> route_history(MissionId id) const;
 
  private:
   struct Mission;
@@ -108,6 +115,10 @@ class DispatchService {
   // Under preemption_mutex_.
   void drain_preemption_events(Staged& staged);
   void emit(const std::string& kind, MissionId mission, const std::string& reason, double now_s);
+  void emit(DispatchEvent event);
+  // Under preemption_mutex_: emits signal_state when the signal's state changed since last said.
+  void announce_signal_state(NodeId node, double now_s);
+  [[nodiscard]] std::string signal_state_locked(NodeId node) const;
   MissionView view(const Mission& m) const;
   // Ends a mission in memory; the caller stores the new state (stage_state) first.
   void finish(Mission& m, MissionState state, double now_s, Staged& staged);
@@ -138,11 +149,12 @@ class DispatchService {
   mutable std::mutex preemption_mutex_;
   preemption::SimulatedSignalController signals_;
   preemption::PreemptionEngine preemption_;
+  std::unordered_map<NodeId, std::string> shown_signal_state_;  // last announced signal_state
 
   mutable std::shared_mutex registry_mutex_;
   std::map<MissionId, MissionPtr> missions_;
   std::unordered_map<std::string, MissionId> active_by_vehicle_;
-  std::unordered_map<std::string, maps::LatLon> last_position_;
+  std::unordered_map<std::string, VehicleView> vehicles_;
 
   // Serializes mission creation (rare): one vehicle never gets two active missions.
   std::mutex create_mutex_;
@@ -162,6 +174,7 @@ class DispatchService {
   mutable std::mutex listeners_mutex_;
   std::map<std::size_t, Listener> listeners_;
   std::size_t next_listener_ = 1;
+  std::uint64_t next_event_seq_ = 1;
 };
 
 }  // namespace corridor::server

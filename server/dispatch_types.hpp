@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "maps/geo.hpp"
+#include "maps/ids.hpp"
 #include "planner/route.hpp"
 #include "preemption/engine.hpp"
 
@@ -61,6 +62,29 @@ struct MissionView {
   std::vector<preemption::ScheduleEntry> schedule;
   double created_s = 0;
   double updated_s = 0;
+  double route_time_s = 0;  // when `route` was computed: its arrival times count from then
+  std::vector<double> congestion_factors;  // per route edge, read with the route
+};
+
+// One stored revision of a mission's route: why it changed, and what it was.
+struct RouteRevisionView {
+  std::uint32_t revision = 0;
+  std::string reason;
+  double time_s = 0;
+  double eta_s = 0;
+  double length_m = 0;
+  std::string geometry_json;  // a GeoJSON LineString
+};
+
+// A vehicle's latest accepted report.
+struct VehicleView {
+  std::string vehicle_id;
+  maps::LatLon position;
+  std::optional<double> heading_deg;
+  std::optional<double> speed_mps;
+  double timestamp_s = 0;
+  std::string source = "gps";
+  std::optional<MissionId> mission;
 };
 
 struct PositionResult {
@@ -89,10 +113,24 @@ struct CongestionResult {
 // built by the codec.
 struct DispatchEvent {
   std::string kind;  // mission_created, mission_completed, mission_cancelled, route_changed, position,
-                     // preemption_<kind>, congestion_applied
+                     // preemption_<kind>, congestion_applied, signal_state
   MissionId mission = 0;
   std::string reason;
   double time_s = 0;
+  std::uint64_t seq = 0;  // set by the service: increasing, so a client can order and deduplicate
+  // What the kind carries (left empty by the others): the vehicle of a mission or position; the
+  // position itself; a route's revision and remaining travel time; the signal of a preemption or
+  // signal_state event and that signal's new state; the edges a congestion report changed.
+  std::string vehicle_id;
+  std::optional<maps::LatLon> position;
+  std::optional<double> heading_deg;
+  std::optional<double> speed_mps;
+  std::optional<double> eta_s;
+  std::string source;
+  std::optional<std::uint32_t> revision;
+  std::optional<NodeId> signal;
+  std::string state;
+  std::optional<std::size_t> edges_changed;
 };
 
 }  // namespace corridor::server

@@ -147,8 +147,10 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     const std::string target(req.target());
     if (websocket::is_upgrade(req)) {
       if (target.rfind("/v1/stream", 0) != 0) return reply_error(404, "not_found", "WebSocket is served on /v1/stream", false);
-      if (!router_.authorize_stream(std::string(req[http::field::authorization]))) {
-        return reply_error(401, "unauthorized", "a viewer or dispatcher token is required for the stream", false);
+      if (!router_.authorize_stream(std::string(req[http::field::authorization]), target)) {
+        return reply_error(401, "unauthorized",
+                           "a viewer or dispatcher token, or a fresh ticket from POST /v1/stream/ticket, is required for the stream",
+                           false);
       }
       std::optional<MissionId> filter;
       if (const auto q = target.find("mission="); q != std::string::npos) {
@@ -166,9 +168,10 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     // worker; it is written on this connection's own io_context.
     HttpRequest request{std::string(req.method_string()), target, std::string(req[http::field::authorization]),
                         std::move(req.body())};
-    auto reply = [self = shared_from_this(), keep_alive = req.keep_alive()](HttpResponse r) {
-      net::dispatch(self->stream_.get_executor(), [self, keep_alive, r = std::move(r)]() mutable {
-        self->respond(r.status, r.content_type, std::move(r.body), keep_alive);
+    const bool head = req.method() == http::verb::head;
+    auto reply = [self = shared_from_this(), keep_alive = req.keep_alive(), head](HttpResponse r) {
+      net::dispatch(self->stream_.get_executor(), [self, keep_alive, head, r = std::move(r)]() mutable {
+        self->respond(r.status, r.content_type, std::move(r.body), keep_alive, r.headers, head);
       });
     };
     if (!router_.blocks(request)) return router_.handle_async(request, std::move(reply));
@@ -183,13 +186,20 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     respond(status, "application/json", error_json(code, message).dump(), keep_alive);
   }
 
-  void respond(int status, const std::string& content_type, std::string body, bool keep_alive) {
+  void respond(int status, const std::string& content_type, std::string body, bool keep_alive,
+               const std::vector<std::pair<std::string, std::string>>& headers = {}, bool head = false) {
     auto res = std::make_shared<http::response<http::string_body>>(static_cast<http::status>(status), 11);
     res->set(http::field::server, "corridor");
     res->set(http::field::content_type, content_type);
+    for (const auto& [name, value] : headers) res->set(name, value);
     res->keep_alive(keep_alive);
-    res->body() = std::move(body);
-    res->prepare_payload();
+    if (head) {
+      // HEAD: the headers GET would send, Content-Length included, and no body.
+      res->content_length(body.size());
+    } else {
+      res->body() = std::move(body);
+      res->prepare_payload();
+    }
     response_ = res;
     http::async_write(stream_, *res, beast::bind_front_handler(&HttpSession::on_write, shared_from_this(), keep_alive));
   }

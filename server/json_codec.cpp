@@ -165,18 +165,52 @@ json mission_to_json(const maps::RoadGraph& graph, const MissionView& m) {
          {"preemption", schedule_to_json(graph, m.schedule)}};
   j["last_position"] = m.last_position ? ll(*m.last_position) : json(nullptr);
   if (!m.route.edges.empty()) {
-    j["route"] = planner::route_to_geojson(graph, m.route, "dstar");
+    j["route"] = planner::route_to_geojson(graph, m.route, "dstar", m.congestion_factors.empty() ? nullptr : &m.congestion_factors);
     j["eta_s"] = m.route.found ? json(m.route.travel_time_s) : json(nullptr);
+    // Absolute, so a console counts down without knowing when the route was read.
+    j["eta_at_s"] = m.route.found && m.state == MissionState::active ? json(m.route_time_s + m.route.travel_time_s) : json(nullptr);
   } else {
     j["route"] = nullptr;
     j["eta_s"] = nullptr;
+    j["eta_at_s"] = nullptr;
   }
   return j;
 }
 
 json event_to_json(const DispatchEvent& e) {
-  json j{{"type", e.kind}, {"time_s", e.time_s}, {"reason", e.reason}};
+  json j{{"type", e.kind}, {"time_s", e.time_s}, {"reason", e.reason}, {"seq", e.seq}};
   j["mission"] = e.mission == 0 ? json(nullptr) : json(e.mission);
+  if (!e.vehicle_id.empty()) j["vehicle_id"] = e.vehicle_id;
+  if (e.position) {
+    j["lat"] = e.position->lat_deg;
+    j["lon"] = e.position->lon_deg;
+    j["heading_deg"] = e.heading_deg ? json(*e.heading_deg) : json(nullptr);
+    j["speed_mps"] = e.speed_mps ? json(*e.speed_mps) : json(nullptr);
+  }
+  if (!e.source.empty()) j["source"] = e.source;
+  if (e.eta_s) j["eta_s"] = std::isfinite(*e.eta_s) ? json(*e.eta_s) : json(nullptr);
+  if (e.revision) j["revision"] = *e.revision;
+  if (e.signal) j["signal"] = e.signal->v;
+  if (!e.state.empty()) j["state"] = e.state;
+  if (e.edges_changed) j["edges_changed"] = *e.edges_changed;
+  return j;
+}
+
+json vehicle_to_json(const VehicleView& v) {
+  json j{{"vehicle_id", v.vehicle_id}, {"lat", v.position.lat_deg}, {"lon", v.position.lon_deg},
+         {"timestamp", v.timestamp_s}, {"source", v.source}};
+  j["heading_deg"] = v.heading_deg ? json(*v.heading_deg) : json(nullptr);
+  j["speed_mps"] = v.speed_mps ? json(*v.speed_mps) : json(nullptr);
+  j["mission"] = v.mission ? json(*v.mission) : json(nullptr);
+  return j;
+}
+
+json revision_to_json(const RouteRevisionView& r) {
+  json geometry = json::parse(r.geometry_json, nullptr, false);
+  if (geometry.is_discarded()) geometry = nullptr;
+  json j{{"revision", r.revision}, {"reason", r.reason}, {"time_s", r.time_s}, {"length_m", r.length_m},
+         {"geometry", std::move(geometry)}};
+  j["eta_s"] = std::isfinite(r.eta_s) ? json(r.eta_s) : json(nullptr);
   return j;
 }
 

@@ -27,6 +27,8 @@ CountsReport counts_from_json(const nlohmann::json& j);
 nlohmann::json mission_to_json(const maps::RoadGraph& graph, const MissionView& m);
 nlohmann::json schedule_to_json(const maps::RoadGraph& graph, const std::vector<preemption::ScheduleEntry>& schedule);
 nlohmann::json event_to_json(const DispatchEvent& e);
+nlohmann::json vehicle_to_json(const VehicleView& v);
+nlohmann::json revision_to_json(const RouteRevisionView& r);
 nlohmann::json error_json(const std::string& code, const std::string& message);
 
 }  // namespace corridor::server

@@ -56,17 +56,47 @@ json map_feature_collection(const maps::RoadGraph& g) {
                           {"osm_way_id", g.osm_way(e).v},
                           {"class", std::string(maps::to_string(g.road_class(e)))},
                           {"speed_kmh", g.speed_mps(e) * 3.6},
-                          {"length_m", g.length_m(e)}}}});
+                          {"length_m", g.length_m(e)},
+                          {"name", g.name(e)},
+                          {"ref", g.ref(e)}}}});
   }
+  const maps::LatLon lo = g.projection().to_lat_lon(g.min_corner());
+  const maps::LatLon hi = g.projection().to_lat_lon(g.max_corner());
   return {{"type", "FeatureCollection"},
           {"features", std::move(features)},
+          {"bounds", {{lo.lon_deg, lo.lat_deg}, {hi.lon_deg, hi.lat_deg}}},
           {"attribution", "© OpenStreetMap contributors, ODbL 1.0"}};
+}
+
+json roles_json(std::uint8_t roles) {
+  json out = json::array();
+  for (auto [role, name] : {std::pair{Role::dispatcher, "dispatcher"}, std::pair{Role::vehicle, "vehicle"},
+                            std::pair{Role::sensor, "sensor"}, std::pair{Role::viewer, "viewer"}}) {
+    if ((roles & static_cast<std::uint8_t>(role)) != 0) out.push_back(name);
+  }
+  return out;
+}
+
+std::string query_value(const std::string& target, const std::string& key) {
+  const auto q = target.find('?');
+  if (q == std::string::npos) return {};
+  std::size_t begin = q + 1;
+  while (begin < target.size()) {
+    const std::size_t end = std::min(target.find('&', begin), target.size());
+    const std::string_view pair(target.data() + begin, end - begin);
+    if (pair.size() > key.size() && pair.substr(0, key.size()) == key && pair[key.size()] == '=') {
+      return std::string(pair.substr(key.size() + 1));
+    }
+    begin = end + 1;
+  }
+  return {};
 }
 
 }  // namespace
 
-Router::Router(DispatchService& service, TokenAuth auth, RouterConfig config, Clock clock)
-    : service_(service), auth_(std::move(auth)), config_(config), clock_(std::move(clock)) {
+Router::Router(DispatchService& service, TokenAuth auth, RouterConfig config, Clock clock,
+               std::shared_ptr<const StaticSite> site)
+    : service_(service), auth_(std::move(auth)), config_(config), clock_(std::move(clock)), site_(std::move(site)) {
   map_geojson_ = map_feature_collection(service_.graph()).dump();
   subscription_ = service_.subscribe([this](const DispatchEvent& e) {
     if (e.kind == "route_changed") metrics_.count("route_changes_total");
@@ -80,13 +110,33 @@ Router::Router(DispatchService& service, TokenAuth auth, RouterConfig config, Cl
   });
   add("GET", "/metrics", 0, "Prometheus metrics", [this](const Principal&, const Match&, const HttpRequest&) {
     metrics_.set_gauge("active_missions", static_cast<double>(service_.active_mission_count()));
-    return HttpResponse{200, "text/plain; version=0.0.4", metrics_.render(), nullptr};
+    return HttpResponse{200, "text/plain; version=0.0.4", metrics_.render(), nullptr, {}};
   });
   add("GET", "/v1/openapi.json", 0, "This API description", [this](const Principal&, const Match&, const HttpRequest&) {
     return json_response(200, openapi());
   });
+  add("GET", "/v1/me", kAllRoles, "The calling token's name and roles", [](const Principal& who, const Match&, const HttpRequest&) {
+    json out{{"name", who.name}, {"roles", roles_json(who.roles)}};
+    out["vehicle_id"] = who.vehicle_id ? json(*who.vehicle_id) : json(nullptr);
+    return HttpResponse{200, "application/json", out.dump(), nullptr, {}};
+  });
+  add("POST", "/v1/stream/ticket", kRead, "A single-use ticket to open the WebSocket stream (?ticket=) within 30 s",
+      [this](const Principal& who, const Match&, const HttpRequest&) {
+        return json_response(200, {{"ticket", tickets_.issue(who, clock_())}, {"expires_in_s", tickets_.config().lifetime_s}});
+      });
+  add("GET", "/v1/vehicles", kRead, "Every vehicle's latest accepted position", [this](const Principal&, const Match&, const HttpRequest&) {
+    json list = json::array();
+    for (const auto& v : service_.vehicles()) list.push_back(vehicle_to_json(v));
+    return json_response(200, {{"vehicles", std::move(list)}});
+  });
+  add("GET", "/v1/missions/{id}/routes", kRead, "A mission's route revisions with their reasons, oldest first",
+      [this](const Principal&, const Match& m, const HttpRequest&) {
+        json list = json::array();
+        for (const auto& r : service_.route_history(parse_id(m.params[0], "mission id"))) list.push_back(revision_to_json(r));
+        return json_response(200, {{"revisions", std::move(list)}});
+      });
   add("GET", "/v1/map", kRead, "The road graph as GeoJSON", [this](const Principal&, const Match&, const HttpRequest&) {
-    return HttpResponse{200, "application/geo+json", map_geojson_, nullptr};
+    return HttpResponse{200, "application/geo+json", map_geojson_, nullptr, {}};
   });
   add("POST", "/v1/missions", kDispatch, "Create a mission", [this](const Principal&, const Match&, const HttpRequest& r) {
     const auto started = std::chrono::steady_clock::now();
@@ -165,7 +215,7 @@ Router::Router(DispatchService& service, TokenAuth auth, RouterConfig config, Cl
     const auto [mode, step] = service_.signal_mode(n);
     return json{{"id", n.v}, {"osm_node", service_.graph().osm_node(n).v}, {"location", {{"lat", at.lat_deg}, {"lon", at.lon_deg}}},
                 {"phases", std::move(phases)}, {"lights", std::move(lights)},
-                {"mode", mode}, {"program_step", step}};
+                {"mode", mode}, {"program_step", step}, {"state", service_.signal_state(n)}};
   };
   add("GET", "/v1/signals", kRead, "Every signalized intersection", [this, signal_json](const Principal&, const Match&, const HttpRequest&) {
     json list = json::array();
@@ -194,7 +244,7 @@ void Router::add(std::string method, std::string pattern, std::uint8_t roles, st
 }
 
 HttpResponse Router::json_response(int status, const json& body) const {
-  return {status, "application/json", body.dump(-1, ' ', false, json::error_handler_t::replace), nullptr};
+  return {status, "application/json", body.dump(-1, ' ', false, json::error_handler_t::replace), nullptr, {}};
 }
 
 bool Router::take_token(const std::string& key, double now_s) {
@@ -210,8 +260,9 @@ bool Router::take_token(const std::string& key, double now_s) {
   return true;
 }
 
-std::optional<Principal> Router::authorize_stream(const std::string& authorization) const {
-  auto who = auth_.authenticate(authorization);
+std::optional<Principal> Router::authorize_stream(const std::string& authorization, const std::string& target) {
+  const std::string ticket = query_value(target, "ticket");
+  auto who = ticket.empty() ? auth_.authenticate(authorization) : tickets_.redeem(ticket, clock_());
   if (!who || (who->roles & kRead) == 0) return std::nullopt;
   return who;
 }
@@ -294,6 +345,16 @@ HttpResponse Router::answer(const HttpRequest& request, std::string& route_name)
         const auto eq = pair.find('=');
         match.query[pair.substr(0, eq)] = eq == std::string::npos ? "" : pair.substr(eq + 1);
       }
+    }
+    // Outside the API: the console's files (GET and HEAD only).
+    if (site_ && path.rfind("/v1/", 0) != 0 && path != "/v1" && path != "/metrics") {
+      route_name = "GET /";
+      if (request.method != "GET" && request.method != "HEAD") {
+        throw ApiError(405, "method_not_allowed", request.method + " is not allowed on " + path.substr(0, 200));
+      }
+      StaticReply r = site_->serve(path);
+      if (r.status != 200) throw ApiError(r.status, r.error_code, r.error_message);
+      return HttpResponse{200, std::move(r.content_type), std::string(r.body), nullptr, std::move(r.headers)};
     }
     bool path_known = false;
     const Route* found = match_route(request.method, path, match.params, path_known);

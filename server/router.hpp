@@ -17,6 +17,8 @@
 #include "server/auth.hpp"
 #include "server/dispatch_service.hpp"
 #include "server/metrics.hpp"
+#include "server/static_site.hpp"
+#include "server/stream_tickets.hpp"
 
 namespace corridor::server {
 
@@ -34,6 +36,8 @@ struct HttpResponse {
   // Set while the request's writes are still on their way to the database: the response may be
   // sent only once this ticket is durable (and becomes a 503 if it fails).
   std::shared_ptr<CommitTicket> after_commit;
+  // More headers (caching, security policy); the transport adds them as they are.
+  std::vector<std::pair<std::string, std::string>> headers;
 };
 
 struct RouterConfig {
@@ -45,7 +49,9 @@ class Router {
  public:
   using Clock = std::function<double()>;  // seconds; wall clock in production, fake in tests
 
-  Router(DispatchService& service, TokenAuth auth, RouterConfig config, Clock clock);
+  // With `site`, paths outside the API (/v1/…, /metrics) are answered from it: the console.
+  Router(DispatchService& service, TokenAuth auth, RouterConfig config, Clock clock,
+         std::shared_ptr<const StaticSite> site = nullptr);
   ~Router();
   Router(const Router&) = delete;
   Router& operator=(const Router&) = delete;
@@ -59,8 +65,9 @@ class Router {
   // they answer (creating and cancelling missions, congestion): a transport runs those off its
   // I/O threads, so that one of them cannot hold up the position reports behind it.
   [[nodiscard]] bool blocks(const HttpRequest& request) const noexcept;
-  // For the WebSocket upgrade: the principal if it may read the stream.
-  [[nodiscard]] std::optional<Principal> authorize_stream(const std::string& authorization) const;
+  // For the WebSocket upgrade: the principal if it may read the stream, from a single-use
+  // ?ticket= in the target (browsers) or else the Authorization header (other clients).
+  [[nodiscard]] std::optional<Principal> authorize_stream(const std::string& authorization, const std::string& target);
   [[nodiscard]] nlohmann::json openapi() const;
   [[nodiscard]] Metrics& metrics() { return metrics_; }
 
@@ -102,6 +109,8 @@ class Router {
   std::mutex buckets_mutex_;
   std::unordered_map<std::string, std::pair<double, double>> buckets_;  // token -> (tokens left, last refill)
   std::size_t subscription_ = 0;
+  std::shared_ptr<const StaticSite> site_;
+  StreamTickets tickets_;
 };
 
 }  // namespace corridor::server

@@ -404,6 +404,18 @@ std::vector<MissionRow> Store::missions(std::optional<MissionState> state) const
   return out;
 }
 
+std::vector<RouteRevisionView> Store::route_revisions(MissionId mission) const {
+  Statement s(db_,
+              "SELECT revision, reason, created_s, eta_s, length_m, geometry FROM route_revisions "
+              "WHERE mission_id = ? ORDER BY revision");
+  s.bind(1, static_cast<std::int64_t>(mission));
+  std::vector<RouteRevisionView> out;
+  while (s.step()) {
+    out.push_back({static_cast<std::uint32_t>(s.integer(0)), s.text(1), s.real(2), s.real(3), s.real(4), s.text(5)});
+  }
+  return out;
+}
+
 std::optional<PositionRow> Store::last_position(const std::string& vehicle_id) const {
   Statement s(db_,
               "SELECT p.lat, p.lon, p.heading_deg, p.timestamp_s FROM vehicle_last_position v "

@@ -94,6 +94,8 @@ class Store {
 
   [[nodiscard]] std::vector<MissionRow> missions(std::optional<MissionState> state) const;
   [[nodiscard]] std::optional<PositionRow> last_position(const std::string& vehicle_id) const;
+  // A mission's route revisions, oldest first.
+  [[nodiscard]] std::vector<RouteRevisionView> route_revisions(MissionId mission) const;
   // The latest condition of every edge whose latest update has not expired by `now_s`.
   [[nodiscard]] std::vector<CongestionRow> congestion_in_force(double now_s) const;
   [[nodiscard]] std::size_t count(const std::string& table) const;
