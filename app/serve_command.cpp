@@ -8,12 +8,15 @@
 #include <iostream>
 #include <memory>
 #include <random>
+#include <thread>
 
 #include "app/cli_error.hpp"
 #include "app/map_options.hpp"
+#include "server/demo_driver.hpp"
 #include "server/dispatch_service.hpp"
 #include "server/http_server.hpp"
 #include "server/router.hpp"
+#include "web/embedded_files.hpp"
 
 namespace corridor::app {
 namespace {
@@ -24,6 +27,7 @@ struct ServeOptions {
   std::string listen = "127.0.0.1:8080";
   std::string config;
   int threads = 2;
+  bool demo = false;
 };
 
 std::string random_token() {
@@ -85,14 +89,35 @@ void run_serve(const ServeOptions& o) {
   server::DispatchConfig dispatch;
   dispatch.repair_threads = o.threads;  // as many as serve requests
   server::DispatchService service(graph, maps::signal_plans_for(map_file, graph), dispatch, &store, now());
-  server::Router router(service, std::move(auth), router_config, now);
+  std::vector<server::StaticAsset> console;
+  for (const auto& f : web::embedded_files()) {
+    console.push_back({f.path, {reinterpret_cast<const char*>(f.data), f.size}});
+  }
+  server::Router router(service, std::move(auth), router_config, now, std::make_shared<server::StaticSite>(console));
   server::HttpServer http(router, service, limits, host, static_cast<unsigned short>(port), o.threads);
   // Printed only once the database and the port are ours, so a server that cannot start shows
   // its error and no token.
   std::cout << "development token (all roles): " << dev_token << std::endl;
   std::cout << "listening on http://" << host << ":" << http.port() << " (map: " << graph.node_count() << " nodes, "
             << service.active_mission_count() << " active missions resumed, db: " << o.db << ")" << std::endl;
+  std::cout << "console: open http://" << (host == "0.0.0.0" ? std::string("127.0.0.1") : host) << ":" << http.port()
+            << "/ and paste the token above" << std::endl;
   spdlog::info("event=serving address={}:{} threads={}", host, http.port(), o.threads);
+  // Declared after the server, so it stops (and is joined) before the server goes.
+  std::jthread demo;
+  if (o.demo) {
+    std::cout << "demo: simulated vehicles drive missions on this map (vehicle ids demo-N)" << std::endl;
+    demo = std::jthread([&service, now](std::stop_token stop) {
+      server::DemoDriver driver(service, {});
+      double last = now();
+      while (!stop.stop_requested()) {
+        std::this_thread::sleep_for(std::chrono::seconds(1));
+        const double t = now();
+        driver.step(t, t - last);
+        last = t;
+      }
+    });
+  }
   http.run();
   spdlog::info("event=stopped");
 }
@@ -107,6 +132,8 @@ void register_serve_command(CLI::App& app) {
   cmd->add_option("--listen", o->listen, "HOST:PORT to listen on (port 0 picks a free one)")->capture_default_str();
   cmd->add_option("--config", o->config, "JSON config: tokens with roles, limits");
   cmd->add_option("--threads", o->threads, "I/O threads; as many repair plans in parallel after a congestion change")->capture_default_str();
+  cmd->add_flag("--demo", o->demo,
+                 "drive simulated vehicles along their missions' routes, and now and then congest a route ahead");
   cmd->callback([o] { run_serve(*o); });
 }
 

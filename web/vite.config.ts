@@ -6,7 +6,8 @@ import { defineConfig } from 'vitest/config';
 const target = process.env.CORRIDOR_URL ?? 'http://127.0.0.1:8080';
 
 export default defineConfig({
-  base: './',
+  // Absolute, so a client-side route such as /missions/3 still finds /assets/.
+  base: '/',
   build: {
     outDir: 'dist',
     // The module-preload polyfill is the only script Vite would inline; the CSP forbids inline

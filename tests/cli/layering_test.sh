@@ -11,6 +11,7 @@ declare -A allowed=(
   [server]="maps planner preemption server"
   [localizer]="maps localizer"
   [bench]="maps planner preemption server bench"
+  [web]="web"
 )
 violations=0
 checked=0
