@@ -10,7 +10,13 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libopencv-dev libeigen3-dev libceres-dev
   osmium-tool sumo sumo-tools python3 curl
+  chromium
 )
+# The console (web/) builds with Node.js and npm; a machine that already has a Node.js with its own
+# npm (for example from NodeSource) keeps it, since Debian's npm would conflict with it.
+if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
+  packages+=(nodejs npm)
+fi
 
 missing=()
 for p in "${packages[@]}"; do

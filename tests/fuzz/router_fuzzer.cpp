@@ -23,7 +23,11 @@ struct Target {
   }();
   server::DispatchService service{graph, {}, nullptr, 0.0};
   double now = 1.0;
-  server::Router router{service, make_auth(), {}, [this] { return now; }};
+  // The console's files too: the static routing (client routes, dot segments, odd bytes) is fuzzed
+  // through the same entry point.
+  server::Router router{service, make_auth(), {}, [this] { return now; },
+                        std::make_shared<server::StaticSite>(std::vector<server::StaticAsset>{
+                            {"/index.html", "<!doctype html>"}, {"/assets/app-1.js", "x"}})};
 
   static server::TokenAuth make_auth() {
     server::TokenAuth auth;
@@ -34,7 +38,9 @@ struct Target {
 
 const char* const kTargets[] = {"/v1/missions", "/v1/missions/1", "/v1/missions/1/cancel", "/v1/congestion",
                                 "/v1/vehicles/amb-1/position", "/v1/signals/0/counts", "/v1/signals", "/v1/signals/7",
-                                "/v1/missions?state=active", "/v1/health", "/metrics", "/v1/map"};
+                                "/v1/missions?state=active", "/v1/health", "/metrics", "/v1/map",
+                                "/v1/me", "/v1/stream/ticket", "/v1/vehicles", "/v1/missions/1/routes",
+                                "/", "/assets/app-1.js", "/missions/1", "/assets/../index.html"};
 
 }  // namespace
 
