@@ -15,6 +15,7 @@
 #include "server/demo_driver.hpp"
 #include "server/dispatch_service.hpp"
 #include "server/http_server.hpp"
+#include "maps/synthetic_grid.hpp"
 #include "server/router.hpp"
 #include "web/embedded_files.hpp"
 
@@ -125,6 +126,16 @@ void run_serve(const ServeOptions& o) {
 }  // namespace
 
 void register_serve_command(CLI::App& app) {
+  // The API description does not depend on the map: a tiny grid stands in for one.
+  app.add_subcommand("openapi", "Print the API's OpenAPI 3 description (what GET /v1/openapi.json serves)")->callback([] {
+    maps::GridSpec spec;
+    spec.rows = 2;
+    spec.cols = 2;
+    const maps::RoadGraph graph = maps::make_perturbed_grid(spec);
+    server::DispatchService service(graph, {}, nullptr, 0.0);
+    const server::Router router(service, {}, {}, [] { return 0.0; });
+    std::cout << router.openapi().dump(2) << std::endl;
+  });
   auto o = std::make_shared<ServeOptions>();
   auto* cmd = app.add_subcommand("serve", "Run the dispatch server (HTTP/JSON API and WebSocket stream)");
   add_map_options(*cmd, o->map);

@@ -8,6 +8,7 @@
 
 #include "maps/errors.hpp"
 #include "server/json_codec.hpp"
+#include "server/openapi_schemas.hpp"
 
 namespace corridor::server {
 namespace {
@@ -423,8 +424,10 @@ json Router::openapi() const {
                         {{"error",
                           {{"type", "object"},
                            {"properties", {{"code", {{"type", "string"}}}, {"message", {{"type", "string"}}}}}}}}}};
+  json schemas = json::parse(openapi_schemas_json());
+  if (!schemas.contains("Error")) schemas["Error"] = std::move(error_schema);
   json components = {{"securitySchemes", {{"bearer", {{"type", "http"}, {"scheme", "bearer"}}}}},
-                     {"schemas", {{"Error", std::move(error_schema)}}}};
+                     {"schemas", std::move(schemas)}};
   return {{"openapi", "3.0.3"},
           {"info", {{"title", "Corridor dispatch API"}, {"version", "1"}}},
           {"paths", std::move(paths)},
