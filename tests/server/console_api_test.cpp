@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "maps/synthetic_grid.hpp"
+#include "tests/server/api_fixture.hpp"
 #include "server/json_codec.hpp"
 #include "server/router.hpp"
 
@@ -11,22 +12,11 @@ namespace {
 
 using nlohmann::json;
 
-const maps::RoadGraph& grid() {
-  static const maps::RoadGraph g = [] {
-    maps::GridSpec spec;
-    spec.rows = 8;
-    spec.cols = 8;
-    spec.seed = 4;
-    spec.oneway_fraction = 0.0;
-    spec.signal_fraction = 0.5;
-    return maps::make_perturbed_grid(spec);
-  }();
-  return g;
-}
+const maps::RoadGraph& grid() { return testing::api_grid(); }
 
-const std::string kDispatcher = "Bearer dispatcher-token-0123456789";
-const std::string kViewer = "Bearer viewer-token-0123456789abc";
-const std::string kSensor = "Bearer sensor-token-0123456789abc";
+using testing::kDispatcher;
+using testing::kSensor;
+using testing::kViewer;
 
 const std::string kIndex = "<!doctype html><script type=module src=/assets/app-1.js></script>";
 const std::string kScript = "console.log(1)";
@@ -48,14 +38,7 @@ struct Rig {
   }
   ~Rig() { service.unsubscribe(subscription); }
 
-  static TokenAuth make_auth() {
-    TokenAuth auth;
-    auth.add_from_config(json::parse(R"({"tokens":[
-      {"token":"dispatcher-token-0123456789","name":"dispatch","roles":["dispatcher"]},
-      {"token":"viewer-token-0123456789abc","name":"wall","roles":["viewer"]},
-      {"token":"sensor-token-0123456789abc","name":"loops","roles":["sensor"]}]})"));
-    return auth;
-  }
+  static TokenAuth make_auth() { return testing::api_auth(); }
   HttpResponse call(const std::string& method, const std::string& target, const std::string& auth = "",
                     const std::string& body = "") {
     return router.handle({method, target, auth, body});

@@ -7,6 +7,7 @@
 #include <random>
 
 #include "maps/synthetic_grid.hpp"
+#include "tests/server/api_fixture.hpp"
 #include "tests/server/temp_db.hpp"
 
 namespace corridor::server {
@@ -14,23 +15,12 @@ namespace {
 
 using nlohmann::json;
 
-const maps::RoadGraph& grid() {
-  static const maps::RoadGraph g = [] {
-    maps::GridSpec spec;
-    spec.rows = 8;
-    spec.cols = 8;
-    spec.seed = 4;
-    spec.oneway_fraction = 0.0;
-    spec.signal_fraction = 0.5;
-    return maps::make_perturbed_grid(spec);
-  }();
-  return g;
-}
+const maps::RoadGraph& grid() { return testing::api_grid(); }
 
-const std::string kDispatcher = "Bearer dispatcher-token-0123456789";
-const std::string kViewer = "Bearer viewer-token-0123456789abc";
-const std::string kSensor = "Bearer sensor-token-0123456789abc";
-const std::string kAmb1 = "Bearer vehicle-amb1-token-0123456";
+using testing::kDispatcher;
+using testing::kSensor;
+using testing::kViewer;
+using testing::kAmb1;
 
 struct Rig {
   DispatchService service{grid(), {}, nullptr, 0.0};
@@ -39,15 +29,7 @@ struct Rig {
 
   Rig() : router(service, make_auth(), {}, [this] { return now; }) {}
 
-  static TokenAuth make_auth() {
-    TokenAuth auth;
-    auth.add_from_config(json::parse(R"({"tokens":[
-      {"token":"dispatcher-token-0123456789","name":"dispatch","roles":["dispatcher"]},
-      {"token":"viewer-token-0123456789abc","name":"wall","roles":["viewer"]},
-      {"token":"sensor-token-0123456789abc","name":"loops","roles":["sensor"]},
-      {"token":"vehicle-amb1-token-0123456","name":"amb1","roles":["vehicle"],"vehicle_id":"amb-1"}]})"));
-    return auth;
-  }
+  static TokenAuth make_auth() { return testing::api_auth(); }
   HttpResponse call(const std::string& method, const std::string& target, const std::string& auth = "",
                     const std::string& body = "") {
     return router.handle({method, target, auth, body});
