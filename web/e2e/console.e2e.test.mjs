@@ -50,14 +50,33 @@ async function pagePoint(page, lat, lon) {
   return p;
 }
 
+/** Page coordinates once the map has stopped moving (two reads 250 ms apart agree). */
+async function stablePoint(page, lat, lon) {
+  let p = await pagePoint(page, lat, lon);
+  for (let i = 0; i < 20; i++) {
+    await page.waitForTimeout(250);
+    const q = await pagePoint(page, lat, lon);
+    if (Math.abs(q.x - p.x) < 0.5 && Math.abs(q.y - p.y) < 0.5) return q;
+    p = q;
+  }
+  return p;
+}
+
 /** Zooms the map in around a point the way a user does: the mouse wheel over it. */
 async function zoomAt(page, lat, lon, notches) {
+  // Zoom out around the map's centre until the point is on screen again.
+  const box = await page.getByTestId('map').boundingBox();
+  const inside = (p) => p.x > box.x + 20 && p.x < box.x + box.width - 20 && p.y > box.y + 20 && p.y < box.y + box.height - 20;
+  for (let i = 0; i < 10 && !inside(await stablePoint(page, lat, lon)); i++) {
+    await page.mouse.move(box.x + box.width / 2, box.y + box.height / 2);
+    await page.mouse.wheel(0, 240);
+  }
   for (let i = 0; i < notches; i++) {
-    const p = await pagePoint(page, lat, lon);
+    const p = await stablePoint(page, lat, lon);
     await page.mouse.move(p.x, p.y);
     await page.mouse.wheel(0, -240);
-    await page.waitForTimeout(400);
   }
+  return stablePoint(page, lat, lon);
 }
 
 describe('dispatch console (Monaco)', () => {
@@ -140,7 +159,7 @@ describe('dispatch console (Monaco)', () => {
     assert.equal(await page.getByTestId('preemption-schedule').locator('tr').count(), mission.preemption.length);
     await page.locator(`[data-testid="schedule-${missionId}-${mission.preemption[0].signal}"]`).waitFor();
     assert.match(await page.getByTestId(`eta-${missionId}`).innerText(), /^\d+:\d\d$/);
-    await page.locator('[data-testid="route-history"] tr[data-reason="created"]').waitFor();
+    await page.locator('[data-testid="route-history"] tr[data-testid="revision-1"]').waitFor();
     await shot(page, 'mission-created');
   });
 
@@ -188,8 +207,7 @@ describe('dispatch console (Monaco)', () => {
       const cs = f.geometry.coordinates;
       const k = Math.floor((cs.length - 1) / 2);
       const mid = [(cs[k][0] + cs[k + 1][0]) / 2, (cs[k][1] + cs[k + 1][1]) / 2];
-      await zoomAt(page, mid[1], mid[0], 2);
-      const p = await pagePoint(page, mid[1], mid[0]);
+      const p = await zoomAt(page, mid[1], mid[0], 2);
       await page.mouse.click(p.x, p.y);
       const picked = Number(await page.getByTestId('congestion-edge').getAttribute('data-edge'));
       assert.ok([f.properties.edge, f.properties.twin].includes(picked), `clicked edge ${f.properties.edge}, the form picked ${picked}`);
@@ -203,7 +221,7 @@ describe('dispatch console (Monaco)', () => {
       }
     }
     assert.ok(changed, 'a factor of 50 on a route edge changed the route');
-    await page.locator('[data-testid="route-history"] tr[data-reason="congestion"]').waitFor({ timeout: 10_000 });
+    await page.locator('[data-testid="route-history"] tr[data-reason="congestion"]').first().waitFor({ timeout: 10_000 });
     const revisions = (await api(server.url, 'GET', `/v1/missions/${missionId}/routes`)).json.revisions;
     assert.ok(revisions.some((r) => r.reason === 'congestion'));
     // The old route is still drawn, faded, for a while.

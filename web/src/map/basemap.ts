@@ -42,19 +42,14 @@ export interface RoadHit {
   latlng: L.LatLng;
 }
 
-interface WayPart {
-  feature: MapFeature;
-  latlngs: L.LatLng[];
-}
-
 export interface BaseMap {
   layer: L.FeatureGroup;
   /** Sorted unique street names (name, or ref when unnamed). */
   names: string[];
   /** A point in the middle of the longest piece of the named street, and the street's bounds. */
   findStreet(name: string): { at: L.LatLng; bounds: L.LatLngBounds } | null;
-  /** Features by edge id (both directions). */
-  byEdge: Map<number, MapFeature>;
+  /** The drawn road nearest to a point, within tolerancePx on screen. */
+  roadAt(latlng: L.LatLng, tolerancePx?: number): RoadHit | null;
   onRoadClick(handler: (hit: RoadHit) => void): void;
   attribution: string;
 }
@@ -64,75 +59,151 @@ function label(p: MapFeature['properties']): string {
   return p.name || p.ref || '';
 }
 
+/** Grid cell size in degrees (~100 m of latitude) for the segment index. */
+const CELL_DEG = 0.001;
+
+/**
+ * Segments of the drawn roads bucketed by grid cell, so a click or hover finds the nearest road
+ * by looking at a few cells instead of asking the canvas renderer to test 15k paths.
+ */
+class SegmentIndex {
+  private readonly cells = new Map<number, number[]>();
+  /** Per segment: feature index and the index of its first coordinate, flattened. */
+  private readonly segs: number[] = [];
+
+  constructor(private readonly features: MapFeature[]) {
+    features.forEach((f, fi) => {
+      const cs = f.geometry.coordinates;
+      for (let i = 1; i < cs.length; i++) {
+        const seg = this.segs.length / 2;
+        this.segs.push(fi, i - 1);
+        const x0 = Math.floor(Math.min(cs[i - 1][0], cs[i][0]) / CELL_DEG);
+        const x1 = Math.floor(Math.max(cs[i - 1][0], cs[i][0]) / CELL_DEG);
+        const y0 = Math.floor(Math.min(cs[i - 1][1], cs[i][1]) / CELL_DEG);
+        const y1 = Math.floor(Math.max(cs[i - 1][1], cs[i][1]) / CELL_DEG);
+        for (let x = x0; x <= x1; x++) {
+          for (let y = y0; y <= y1; y++) {
+            const key = SegmentIndex.key(x, y);
+            const list = this.cells.get(key);
+            if (list) list.push(seg);
+            else this.cells.set(key, [seg]);
+          }
+        }
+      }
+    });
+  }
+
+  private static key(x: number, y: number): number {
+    // Cells of 0.001 degrees: x in [-180000, 180000], y in [-90000, 90000].
+    return (x + 200_000) * 400_000 + (y + 200_000);
+  }
+
+  nearest(map: L.Map, latlng: L.LatLng, tolerancePx: number): MapFeature | null {
+    const p = map.latLngToLayerPoint(latlng);
+    const corner = map.layerPointToLatLng(p.add([tolerancePx, -tolerancePx]));
+    const rx = Math.abs(corner.lng - latlng.lng);
+    const ry = Math.abs(corner.lat - latlng.lat);
+    const x0 = Math.floor((latlng.lng - rx) / CELL_DEG);
+    const x1 = Math.floor((latlng.lng + rx) / CELL_DEG);
+    const y0 = Math.floor((latlng.lat - ry) / CELL_DEG);
+    const y1 = Math.floor((latlng.lat + ry) / CELL_DEG);
+    if ((x1 - x0 + 1) * (y1 - y0 + 1) > 400) return null; // zoomed too far out to point at a road
+    let best: MapFeature | null = null;
+    let bestD = tolerancePx;
+    const seen = new Set<number>();
+    for (let x = x0; x <= x1; x++) {
+      for (let y = y0; y <= y1; y++) {
+        for (const seg of this.cells.get(SegmentIndex.key(x, y)) ?? []) {
+          if (seen.has(seg)) continue;
+          seen.add(seg);
+          const f = this.features[this.segs[2 * seg]];
+          const i = this.segs[2 * seg + 1];
+          const a = f.geometry.coordinates[i];
+          const b = f.geometry.coordinates[i + 1];
+          const d = L.LineUtil.pointToSegmentDistance(p, map.latLngToLayerPoint([a[1], a[0]]), map.latLngToLayerPoint([b[1], b[0]]));
+          if (d < bestD) {
+            bestD = d;
+            best = f;
+          }
+        }
+      }
+    }
+    return best;
+  }
+}
+
 export function createBaseMap(map: L.Map, fc: MapFeatureCollection): BaseMap {
-  const renderer = L.canvas({ padding: 0.3, tolerance: 4 });
+  // Not interactive: the canvas renderer would hit-test every road on each mouse move. The
+  // segment index answers "which road is here" instead.
+  const renderer = L.canvas({ padding: 0.3 });
   const layer = L.featureGroup();
-  const byEdge = new Map<number, MapFeature>();
-  const parts = new WeakMap<L.Polyline, WayPart[]>();
   const streets = new Map<string, MapFeature[]>();
+  const drawn: MapFeature[] = [];
 
   // Group by (way, class) so a way whose class changes midway keeps both colours.
-  const ways = new Map<string, WayPart[]>();
+  const ways = new Map<string, L.LatLngExpression[][]>();
+  const wayClass = new Map<string, string>();
   for (const f of fc.features) {
     const p = f.properties;
-    byEdge.set(p.edge, f);
     const name = label(p);
     if (name) {
       const list = streets.get(name);
       if (list) list.push(f);
       else streets.set(name, [f]);
     }
+    // One direction of a two-way road is drawn (and picked; the form offers both directions).
     if (p.twin !== null && p.twin !== undefined && p.twin < p.edge) continue;
-    const latlngs = f.geometry.coordinates.map((c) => L.latLng(c[1], c[0]));
+    drawn.push(f);
+    const latlngs = f.geometry.coordinates.map((c) => [c[1], c[0]] as L.LatLngTuple);
     const key = `${p.osm_way_id}|${p.class}`;
     const list = ways.get(key);
-    if (list) list.push({ feature: f, latlngs });
-    else ways.set(key, [{ feature: f, latlngs }]);
+    if (list) list.push(latlngs);
+    else {
+      ways.set(key, [latlngs]);
+      wayClass.set(key, p.class);
+    }
   }
   // Thin roads first, so main roads are drawn over them.
-  const entries = [...ways.values()].sort((a, b) => roadStyle(a[0].feature.properties.class).weight - roadStyle(b[0].feature.properties.class).weight);
-  for (const wayParts of entries) {
-    const style = roadStyle(wayParts[0].feature.properties.class);
-    const line = L.polyline(
-      wayParts.map((w) => w.latlngs),
-      { renderer, color: style.color, weight: style.weight, opacity: 1, lineCap: 'round', lineJoin: 'round', interactive: true, bubblingMouseEvents: true },
-    );
-    parts.set(line, wayParts);
-    layer.addLayer(line);
+  const keys = [...ways.keys()].sort((a, b) => roadStyle(wayClass.get(a) as string).weight - roadStyle(wayClass.get(b) as string).weight);
+  for (const key of keys) {
+    const style = roadStyle(wayClass.get(key) as string);
+    layer.addLayer(L.polyline(ways.get(key) as L.LatLngExpression[][], { renderer, color: style.color, weight: style.weight, opacity: 1, lineCap: 'round', lineJoin: 'round', interactive: false }));
   }
-
-  const hover = L.tooltip({ sticky: true, direction: 'top', offset: L.point(0, -6), className: 'road-tooltip' });
-  const hitAt = (line: L.Polyline, latlng: L.LatLng): RoadHit | null => {
-    const list = parts.get(line);
-    if (!list) return null;
-    const p = map.latLngToLayerPoint(latlng);
-    let best: WayPart | null = null;
-    let bestD = Infinity;
-    for (const w of list) {
-      for (let i = 1; i < w.latlngs.length; i++) {
-        const d = L.LineUtil.pointToSegmentDistance(p, map.latLngToLayerPoint(w.latlngs[i - 1]), map.latLngToLayerPoint(w.latlngs[i]));
-        if (d < bestD) {
-          bestD = d;
-          best = w;
-        }
-      }
-    }
-    if (!best) return null;
-    const q = best.feature.properties;
+  const index = new SegmentIndex(drawn);
+  const roadAt = (latlng: L.LatLng, tolerancePx = 8): RoadHit | null => {
+    const f = index.nearest(map, latlng, tolerancePx);
+    if (!f) return null;
+    const q = f.properties;
     return { edge: q.edge, twin: q.twin ?? null, name: q.name, ref: q.ref, cls: q.class, latlng };
   };
-  layer.on('mousemove', (e: L.LeafletMouseEvent) => {
-    const hit = hitAt(e.propagatedFrom as L.Polyline, e.latlng);
-    if (!hit) return;
-    const text = [hit.name || hit.ref || 'unnamed', hit.cls, `edge ${hit.edge}`].join(' · ');
-    hover.setLatLng(e.latlng).setContent(escapeHtml(text));
-    if (!map.hasLayer(hover)) hover.addTo(map);
+
+  // Street name under the mouse, looked up at most once per frame.
+  const hover = L.tooltip({ sticky: true, direction: 'top', offset: L.point(0, -6), className: 'road-tooltip' });
+  let pending: L.LatLng | null = null;
+  map.on('mousemove', (e: L.LeafletMouseEvent) => {
+    if (pending) {
+      pending = e.latlng;
+      return;
+    }
+    pending = e.latlng;
+    requestAnimationFrame(() => {
+      const at = pending as L.LatLng;
+      pending = null;
+      const hit = roadAt(at, 6);
+      if (!hit) {
+        hover.remove();
+        return;
+      }
+      hover.setLatLng(at).setContent(escapeHtml([hit.name || hit.ref || 'unnamed', hit.cls, `edge ${hit.edge}`].join(' · ')));
+      if (!map.hasLayer(hover)) hover.addTo(map);
+    });
   });
-  layer.on('mouseout', () => hover.remove());
+  map.on('mouseout', () => hover.remove());
 
   const clickHandlers: ((hit: RoadHit) => void)[] = [];
-  layer.on('click', (e: L.LeafletMouseEvent) => {
-    const hit = hitAt(e.propagatedFrom as L.Polyline, e.latlng);
+  map.on('click', (e: L.LeafletMouseEvent) => {
+    if (clickHandlers.length === 0) return;
+    const hit = roadAt(e.latlng, 10);
     if (hit) for (const h of clickHandlers) h(hit);
   });
 
@@ -142,8 +213,8 @@ export function createBaseMap(map: L.Map, fc: MapFeatureCollection): BaseMap {
   return {
     layer,
     names: [...streets.keys()].sort((a, b) => a.localeCompare(b)),
-    byEdge,
     attribution,
+    roadAt,
     onRoadClick: (h) => clickHandlers.push(h),
     findStreet(name: string) {
       const wanted = name.trim().toLowerCase();
