@@ -158,7 +158,12 @@ describe('dispatch console (Monaco)', () => {
     assert.ok((await page.getByTestId('steps').locator('li').count()) >= 2);
     assert.equal(await page.getByTestId('preemption-schedule').locator('tr').count(), mission.preemption.length);
     await page.locator(`[data-testid="schedule-${missionId}-${mission.preemption[0].signal}"]`).waitFor();
-    assert.match(await page.getByTestId(`eta-${missionId}`).innerText(), /^\d+:\d\d$/);
+    // The countdown shows the server's predicted arrival (eta_at_s) as time left.
+    const eta = await page.getByTestId(`eta-${missionId}`).innerText();
+    assert.match(eta, /^\d+:\d\d$/);
+    const [mm, ss] = eta.split(':').map(Number);
+    const left = mission.eta_at_s - Date.now() / 1000;
+    assert.ok(Math.abs(mm * 60 + ss - left) < 5, `countdown ${eta}, server eta_at_s is ${left.toFixed(1)} s away`);
     await page.locator('[data-testid="route-history"] tr[data-testid="revision-1"]').waitFor();
     await shot(page, 'mission-created');
   });
@@ -268,6 +273,8 @@ describe('dispatch console (Monaco)', () => {
     await page.locator(`[data-testid="signal-${target.signal}"][data-state="held"]`).waitFor({ timeout: 10_000 });
     await page.locator(`[data-testid="preemption-${target.signal}"][data-state="active"]`).waitFor({ timeout: 10_000 });
     await page.locator('[data-testid="event-log"] li[data-type="preemption_started"]').first().waitFor();
+    // Bring the signal into view for the screenshot (the map may still be zoomed on the reroute).
+    await zoomAt(page, target.location.lat, target.location.lon, 0);
     await shot(page, 'signal-held');
   });
 
