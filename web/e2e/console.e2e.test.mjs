@@ -317,6 +317,35 @@ describe('dispatch console (Monaco)', () => {
     await sensor.context.close();
   });
 
+  it('reconnects by itself after the server restarts, resynchronises, and follows the new stream', async () => {
+    const { page } = dispatcher;
+    const eventsBefore = await page.evaluate(() => window.__corridor.state().stats.applied);
+    const problemsBefore = dispatcher.problems.length;
+    await server.restart();
+    await page.locator('[data-testid="connection-status"][data-state="reconnecting"]').waitFor({ timeout: 10_000 });
+    assert.match(await page.getByTestId('connection-status').innerText(), /^reconnecting in \d+s$/);
+    await shot(page, 'reconnecting');
+    // Written while the console is still waiting to reconnect: it must arrive by the resync.
+    await api(server.url, 'POST', '/v1/vehicles/amb-2/position', { body: { lat: ORIGIN.lat, lon: ORIGIN.lon, timestamp: Date.now() / 1000, heading_deg: 90 } });
+    const created = (await api(server.url, 'POST', '/v1/missions', { body: { vehicle_id: 'amb-2', destination: DESTINATION, priority: 5 } })).json;
+    await page.locator('[data-testid="connection-status"][data-state="live"]').waitFor({ timeout: 30_000 });
+    await page.getByTestId(`mission-row-${created.id}`).waitFor();
+    // The restarted server numbers its events from the start again; the console still applies them.
+    const coords = created.route.geometry.coordinates;
+    const c = coords[Math.min(2, coords.length - 1)];
+    await api(server.url, 'POST', '/v1/vehicles/amb-2/position', { body: { lat: c[1], lon: c[0], timestamp: Date.now() / 1000, heading_deg: 45, speed_mps: 8 } });
+    await waitFor('the position after the restart', async () => {
+      const lat = Number(await page.getByTestId('vehicle-amb-2').getAttribute('data-lat'));
+      return Math.abs(lat - c[1]) < 3e-4;
+    });
+    assert.ok((await page.evaluate(() => window.__corridor.state().stats.applied)) > eventsBefore);
+    await api(server.url, 'POST', `/v1/missions/${created.id}/cancel`);
+    await shot(page, 'reconnected');
+    // While the server was down the browser logged the refused connections; nothing else counts.
+    const during = dispatcher.problems.splice(problemsBefore);
+    dispatcher.problems.push(...during.filter((p) => !/Failed to load resource|WebSocket connection to .* failed|ERR_CONNECTION_REFUSED/.test(p)));
+  });
+
   it('made no request to any origin but the server, never put the token in the stream URL, and broke no CSP rule', async () => {
     const origin = new URL(base);
     const foreign = dispatcher.requests.filter((u) => {

@@ -26,6 +26,41 @@ export function artifactsDir() {
   return dir;
 }
 
+/** Spawns `corridor serve` with args; resolves with the child and its URL once it listens. */
+function spawnServer(bin, args, timeoutMs) {
+  const child = spawn(bin, args, { env: { ...process.env, CORRIDOR_DEV_TOKEN: DEV_TOKEN }, stdio: ['ignore', 'pipe', 'pipe'] });
+  const state = { child, output: '' };
+  return new Promise((resolvePromise, reject) => {
+    const timer = setTimeout(() => reject(new Error(`server did not start in ${timeoutMs} ms:\n${state.output}`)), timeoutMs);
+    child.stdout.on('data', (chunk) => {
+      state.output = (state.output + chunk.toString()).slice(-20000);
+      const m = /listening on (http:\/\/127\.0\.0\.1:(\d+))/.exec(state.output);
+      if (m && !state.url) {
+        state.url = m[1];
+        clearTimeout(timer);
+        resolvePromise(state);
+      }
+    });
+    child.stderr.on('data', (c) => (state.output = (state.output + c.toString()).slice(-20000)));
+    child.on('exit', (code) => {
+      clearTimeout(timer);
+      if (!state.url) reject(new Error(`server exited with ${code} before listening:\n${state.output}`));
+    });
+  });
+}
+
+function stopChild(child) {
+  if (child.exitCode !== null || child.signalCode !== null) return Promise.resolve();
+  return new Promise((r) => {
+    const t = setTimeout(() => child.kill('SIGKILL'), 5000);
+    child.on('exit', () => {
+      clearTimeout(t);
+      r();
+    });
+    child.kill('SIGTERM');
+  });
+}
+
 /** Starts `corridor serve`; resolves once it prints its address. */
 export async function startServer({ map, timeoutMs = 120_000 } = {}) {
   const bin = process.env.CORRIDOR_BIN;
@@ -38,49 +73,23 @@ export async function startServer({ map, timeoutMs = 120_000 } = {}) {
     ],
   };
   writeFileSync(join(dir, 'config.json'), JSON.stringify(config));
-  const args = ['serve', '--listen', '127.0.0.1:0', '--db', join(dir, 'e2e.db'), '--config', join(dir, 'config.json')];
-  if (map) args.push('--map', map);
-  const child = spawn(bin, args, { env: { ...process.env, CORRIDOR_DEV_TOKEN: DEV_TOKEN }, stdio: ['ignore', 'pipe', 'pipe'] });
-  let output = '';
-  const url = await new Promise((resolvePromise, reject) => {
-    const timer = setTimeout(() => reject(new Error(`server did not start in ${timeoutMs} ms:\n${output}`)), timeoutMs);
-    const onData = (chunk) => {
-      output += chunk.toString();
-      const m = /listening on (http:\/\/127\.0\.0\.1:(\d+))/.exec(output);
-      if (m) {
-        clearTimeout(timer);
-        resolvePromise(m[1]);
-      }
-    };
-    child.stdout.on('data', onData);
-    child.stderr.on('data', (c) => (output += c.toString()));
-    child.on('exit', (code) => {
-      clearTimeout(timer);
-      reject(new Error(`server exited with ${code} before listening:\n${output}`));
-    });
-  });
-  child.stdout.removeAllListeners('data');
-  child.stdout.on('data', () => {});
-  child.stderr.removeAllListeners('data');
-  child.stderr.on('data', (c) => (output = (output + c.toString()).slice(-20000)));
+  const args = (listen) => {
+    const a = ['serve', '--listen', listen, '--db', join(dir, 'e2e.db'), '--config', join(dir, 'config.json')];
+    if (map) a.push('--map', map);
+    return a;
+  };
+  let current = await spawnServer(bin, args('127.0.0.1:0'), timeoutMs);
+  const url = current.url;
   return {
     url,
     dir,
-    log: () => output,
-    async stop() {
-      if (child.exitCode !== null) return;
-      child.kill('SIGTERM');
-      await new Promise((r) => {
-        const t = setTimeout(() => {
-          child.kill('SIGKILL');
-          r();
-        }, 5000);
-        child.on('exit', () => {
-          clearTimeout(t);
-          r();
-        });
-      });
+    log: () => current.output,
+    /** Stops the server and starts it again on the same address and database. */
+    async restart() {
+      await stopChild(current.child);
+      current = await spawnServer(bin, args(new URL(url).host), timeoutMs);
     },
+    stop: () => stopChild(current.child),
   };
 }
 
