@@ -137,11 +137,21 @@ describe('dispatch console (Monaco)', () => {
 
   it('creates a mission by clicking the destination and draws its route and preemption schedule', async () => {
     const { page } = dispatcher;
+    // A street name from the map's own names puts the destination on that street...
+    await page.getByTestId('street-search').fill("Boulevard d'Italie");
+    await page.getByTestId('street-go').click();
+    await waitFor('the searched street as destination', async () => (await page.getByTestId('destination-text').innerText()).startsWith('43.7'));
+    await page.getByTestId('destination-pin').waitFor();
+    // ...and a click on the map moves it.
     await page.getByTestId('vehicle-input').fill('amb-1');
     await page.getByTestId('priority-input').fill('3');
-    const p = await pagePoint(page, DESTINATION.lat, DESTINATION.lon);
+    await zoomAt(page, DESTINATION.lat, DESTINATION.lon, 0);
+    const p = await stablePoint(page, DESTINATION.lat, DESTINATION.lon);
     await page.mouse.click(p.x, p.y);
-    await waitFor('the destination to be set', async () => (await page.getByTestId('destination-text').innerText()).includes('43.7'));
+    await waitFor('the clicked destination', async () => {
+      const [lat, lon] = (await page.getByTestId('destination-text').innerText()).split(',').map(Number);
+      return metres([lon, lat], [DESTINATION.lon, DESTINATION.lat]) < 20;
+    });
     await page.getByTestId('create-mission').click();
     await page.locator('[data-testid="mission-detail"]:not([hidden])').waitFor();
     assert.equal(await page.getByTestId('dispatch-error').innerText(), '');
