@@ -109,7 +109,7 @@ describe('dispatch console (Monaco)', () => {
       assert.ok(res.ok && type.includes('text/html'), `the server does not serve the console at / (${res.status} ${type}); build web/ and set CORRIDOR_E2E_DIST=web/dist to serve it from the test`);
     }
     browser = await launchBrowser();
-    console.log(`# server ${server.url}, console ${base}, artifacts ${artifacts}`);
+    console.log(`server ${server.url}, console ${base}, artifacts ${artifacts}`);
   });
 
   after(async () => {
@@ -442,7 +442,7 @@ describe('dispatch console under load (Porto)', { skip: !PORTO || !existsSync(PO
       await session.page.screenshot({ path: join(artifacts, 'porto-load.png') });
       const result = { map: PORTO, map_features: features, map_ready_ms: Math.round(mapReadyMs), sign_in_to_live_ms: signInToLiveMs, positions_posted: posted, ...fps, page: state };
       writeFileSync(join(artifacts, 'porto_perf.json'), JSON.stringify(result, null, 2));
-      console.log(`# porto ${JSON.stringify(result)}`);
+      console.log(`porto ${JSON.stringify(result)}`);
       assert.equal(state.missions, 50);
       assert.equal(state.vehicles, 200);
       await session.context.close();

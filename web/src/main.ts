@@ -141,6 +141,8 @@ async function start(me: Me): Promise<void> {
     onAuthFailure: () => showLogin('The server refused the token; sign in again.', (t) => void signIn(t)),
   });
   const select = (id: number) => {
+    const bounds = routes.bounds(id);
+    if (bounds && store.getState().selectedMission !== id) map?.fitBounds(bounds, { padding: [40, 40], maxZoom: 17 });
     store.dispatch({ type: 'select', mission: id });
     void sync.refreshRoutes(id);
     void sync.refreshMission(id);

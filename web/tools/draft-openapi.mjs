@@ -56,7 +56,7 @@ const paths = {
   },
   '/v1/vehicles': { get: op('Every vehicle with its last position', json(list('vehicles', 'Vehicle'))) },
   '/v1/vehicles/{id}/position': {
-    post: op('Report a vehicle position', json({ type: 'object' }), { parameters: [idParam], requestBody: body(ref('PositionReport')) }),
+    post: op('Report a vehicle position', json(ref('PositionResult')), { parameters: [idParam], requestBody: body(ref('PositionReport')) }),
   },
   '/v1/congestion': {
     post: op('Report congestion on edges or OSM ways', json(ref('CongestionResult')), { requestBody: body(ref('CongestionRequest')) }),

@@ -9,6 +9,7 @@ import type {
   MissionRequest,
   MissionState,
   PositionReport,
+  PositionResult,
   RouteRevision,
   Signal,
   Ticket,
@@ -99,7 +100,7 @@ export class ApiClient {
   async vehicles(): Promise<Vehicle[]> {
     return (await this.request<{ vehicles: Vehicle[] }>('GET', '/v1/vehicles')).vehicles;
   }
-  postPosition(vehicleId: string, report: PositionReport): Promise<unknown> {
+  postPosition(vehicleId: string, report: PositionReport): Promise<PositionResult> {
     return this.request('POST', `/v1/vehicles/${encodeURIComponent(vehicleId)}/position`, report);
   }
   congestion(body: CongestionRequest): Promise<CongestionResult> {

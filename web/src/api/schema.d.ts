@@ -1172,7 +1172,7 @@ export interface paths {
                         [name: string]: unknown;
                     };
                     content: {
-                        "application/json": Record<string, never>;
+                        "application/json": components["schemas"]["PositionResult"];
                     };
                 };
                 /** @description Malformed request */
@@ -1707,6 +1707,8 @@ export interface components {
                 /** @description Per edge: 1 is free flow; very large or null is closed */
                 congestion_factors?: (number | null)[];
                 steps?: components["schemas"]["Step"][];
+                /** @description Per edge: the street name (or ref), empty when none */
+                names?: string[];
             };
         };
         /** @description One signal's preemption for a mission. */
@@ -1726,7 +1728,7 @@ export interface components {
             arrival_s: number;
             /** @description Unix seconds: the signal returns to its program */
             release_s: number;
-            /** @description scheduled, active, released, or another state the server adds later */
+            /** @description planned, active, released, cancelled, expired, or another state the server adds later */
             state: string;
             deferred: boolean;
         };
@@ -1758,7 +1760,7 @@ export interface components {
         };
         RouteRevision: {
             revision: number;
-            /** @description created, congestion, deviation, position, restored, ... */
+            /** @description Why the route changed: dispatch (the first route), congestion, deviation, position, restored, ... */
             reason: string;
             time_s: number;
             eta_s: number | null;
@@ -1866,6 +1868,17 @@ export interface components {
             /** @description [[minLon, minLat], [maxLon, maxLat]] */
             bounds: number[][];
             features: components["schemas"]["MapFeature"][];
+        };
+        /** @description The answer to a position report */
+        PositionResult: {
+            accepted: boolean;
+            /** @description The report completed the vehicle's mission */
+            completed: boolean;
+            eta_s: number | null;
+            mission: number | null;
+            route_changed: boolean;
+            /** @description Distance from the report to the road it was snapped to */
+            snap_distance_m: number | null;
         };
     };
     responses: never;

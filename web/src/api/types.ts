@@ -20,6 +20,7 @@ export type LatLon = S['LatLon'];
 export type LineString = S['LineString'];
 export type MissionRequest = S['MissionRequest'];
 export type PositionReport = S['PositionReport'];
+export type PositionResult = S['PositionResult'];
 export type CongestionRequest = S['CongestionRequest'];
 export type CongestionResult = S['CongestionResult'];
 export type Health = S['Health'];

@@ -104,9 +104,11 @@ export class RouteLayers {
       }
       if (selected) for (const b of BUCKETS) layers.lines[b].bringToFront();
     }
-    layers.destination.setLatLng([m.destination.lat, m.destination.lon]);
-    if (!layers.group.hasLayer(layers.destination)) layers.destination.addTo(layers.group);
-    layers.destination.getElement()?.setAttribute('data-testid', `mission-destination-${m.id}`);
+    if (!layers.mission || layers.mission.destination !== m.destination) layers.destination.setLatLng([m.destination.lat, m.destination.lon]);
+    if (!layers.group.hasLayer(layers.destination)) {
+      layers.destination.addTo(layers.group);
+      layers.destination.getElement()?.setAttribute('data-testid', `mission-destination-${m.id}`);
+    }
 
     // Preemption schedule: one small marker per signal on the route, with its predicted arrival.
     const seen = new Set<number>();

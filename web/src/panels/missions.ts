@@ -84,6 +84,13 @@ export class MissionPanel {
         cells[4].setAttribute('data-testid', `eta-${m.id}`);
         const tr = h('tr', { testid: `mission-row-${m.id}` }, cells);
         tr.onclick = () => this.onSelect(m.id);
+        tr.tabIndex = 0;
+        tr.onkeydown = (e) => {
+          if (e.key === 'Enter' || e.key === ' ') {
+            e.preventDefault();
+            this.onSelect(m.id);
+          }
+        };
         row = { tr, cells, mission: null };
         this.rows.set(m.id, row);
       }
