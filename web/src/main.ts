@@ -27,7 +27,10 @@ interface TestHook {
   state: () => State;
   /** Page coordinates (CSS pixels) of a lat/lon on the map, for clicking it. */
   pagePoint: (lat: number, lon: number) => { x: number; y: number } | null;
-  fps: { start: () => void; stop: () => { frames: number; renders: number; seconds: number; fps: number; renders_per_s: number } };
+  fps: {
+    start: () => void;
+    stop: () => { frames: number; renders: number; seconds: number; fps: number; renders_per_s: number; render_ms_mean: number; render_ms_max: number };
+  };
 }
 
 declare global {
@@ -40,6 +43,8 @@ const store = new Store((fn) => requestAnimationFrame(fn));
 const api = new ApiClient('');
 let map: L.Map | null = null;
 let renders = 0;
+/** Time spent in render (ms): total and longest since the frame counter started. */
+const renderTime = { total: 0, max: 0 };
 
 const timings = { mapReadyMs: null as number | null, mapFeatures: 0 };
 let frames = 0;
@@ -69,6 +74,8 @@ const hook: TestHook = Object.freeze({
     start: () => {
       frames = 0;
       rendersFrom = renders;
+      renderTime.total = 0;
+      renderTime.max = 0;
       framesFrom = performance.now();
       counting = true;
       requestAnimationFrame(countFrames);
@@ -77,7 +84,15 @@ const hook: TestHook = Object.freeze({
       counting = false;
       const seconds = (performance.now() - framesFrom) / 1000;
       const r = renders - rendersFrom;
-      return { frames, renders: r, seconds, fps: frames / seconds, renders_per_s: r / seconds };
+      return {
+        frames,
+        renders: r,
+        seconds,
+        fps: frames / seconds,
+        renders_per_s: r / seconds,
+        render_ms_mean: r > 0 ? renderTime.total / r : 0,
+        render_ms_max: renderTime.max,
+      };
     },
   }),
 });
@@ -166,6 +181,7 @@ async function start(me: Me): Promise<void> {
 
   const render = (state: State, previous: State | null) => {
     renders++;
+    const t = performance.now();
     const now = Date.now();
     renderStatus(state, now);
     signals.update(state, previous);
@@ -175,6 +191,9 @@ async function start(me: Me): Promise<void> {
     log.render(state, previous);
     dispatch?.render(state, previous);
     congestion?.sync();
+    const ms = performance.now() - t;
+    renderTime.total += ms;
+    renderTime.max = Math.max(renderTime.max, ms);
   };
   store.subscribe(render);
   render(store.getState(), null);
