@@ -153,7 +153,8 @@ async function start(me: Me): Promise<void> {
     openSocket: (url) => new WebSocket(url),
     streamUrl: (ticket) => streamUrl(location, ticket),
     isOnline: () => navigator.onLine,
-    onAuthFailure: () => showLogin('The server refused the token; sign in again.', (t) => void signIn(t)),
+    // The map and panels exist already: with the new token (saved by the form) start afresh.
+    onAuthFailure: () => showLogin('The server refused the token; sign in again.', () => location.reload()),
   });
   const select = (id: number) => {
     const bounds = routes.bounds(id);
