@@ -157,8 +157,6 @@ async function start(me: Me): Promise<void> {
     onAuthFailure: () => showLogin('The server refused the token; sign in again.', () => location.reload()),
   });
   const select = (id: number) => {
-    const bounds = routes.bounds(id);
-    if (bounds && store.getState().selectedMission !== id) map?.fitBounds(bounds, { padding: [40, 40], maxZoom: 17 });
     store.dispatch({ type: 'select', mission: id });
     void sync.refreshRoutes(id);
     void sync.refreshMission(id);
@@ -180,6 +178,9 @@ async function start(me: Me): Promise<void> {
   const missions = new MissionPanel(store, api, roles.has('dispatcher'), select);
   const log = new EventLog(() => store.getState());
 
+  // The map shows a newly selected mission's whole route once (after a click in the list, on its
+  // vehicle, or when the dispatcher has just created it); afterwards the view is the user's.
+  let fitted: number | null = null;
   const render = (state: State, previous: State | null) => {
     renders++;
     const t = performance.now();
@@ -187,6 +188,11 @@ async function start(me: Me): Promise<void> {
     renderStatus(state, now);
     signals.update(state, previous);
     routes.update(state, previous);
+    if (state.selectedMission !== fitted) {
+      const bounds = state.selectedMission !== null ? routes.bounds(state.selectedMission) : null;
+      if (bounds) map?.fitBounds(bounds, { padding: [40, 40], maxZoom: 17, animate: false });
+      if (bounds || state.selectedMission === null) fitted = state.selectedMission;
+    }
     vehicles.update(state, previous);
     missions.render(state, previous, now);
     log.render(state, previous);

@@ -91,6 +91,16 @@ describe('reducer: a replayed mission stream', () => {
   });
 });
 
+describe('reducer: vehicles and their missions', () => {
+  it('marks a vehicle as on a mission when the mission is created, and frees it when it ends', () => {
+    const base = replay([{ type: 'snapshot', missions: [], vehicles: [vehicle('amb-1')], signals: [], nowMs: 0 }]);
+    const on = reduce(base, { type: 'missions', missions: [mission(1)], nowMs: 0 });
+    expect(on.vehicles['amb-1'].mission).toBe(1);
+    const off = reduce(on, { type: 'missions', missions: [mission(1, { state: 'cancelled', updated_s: T0 + 1 })], nowMs: 0 });
+    expect(off.vehicles['amb-1'].mission).toBeNull();
+  });
+});
+
 describe('reducer: snapshot then events', () => {
   it('holds events that arrive before the snapshot and applies them after it', () => {
     const s = replay([

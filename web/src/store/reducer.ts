@@ -46,7 +46,7 @@ export function reduce(state: State, action: Action): State {
         previousRoutes = merged.previousRoutes;
       }
       if (missions === state.missions) return state;
-      return { ...state, missions: pruneFinished(missions), previousRoutes };
+      return { ...state, missions: pruneFinished(missions), previousRoutes, vehicles: linkVehicles(state.vehicles, action.missions) };
     }
     case 'routes':
       return { ...state, routeHistory: { ...state.routeHistory, [action.mission]: action.revisions } };
@@ -192,6 +192,18 @@ export function applyEvent(state: State, e: ServerEvent): State {
     if (s && s.state !== e.state) next = { ...next, signals: { ...next.signals, [e.signal]: { ...s, state: e.state as Signal['state'] } } };
   }
   return next;
+}
+
+/** A vehicle shows the mission it is on: set by an active mission's copy, cleared by an ended one. */
+function linkVehicles(vehicles: Record<string, Vehicle>, missions: Mission[]): Record<string, Vehicle> {
+  let out = vehicles;
+  for (const m of missions) {
+    const v = out[m.vehicle_id];
+    if (!v) continue;
+    const want = m.state === 'active' ? m.id : v.mission === m.id ? null : v.mission;
+    if (v.mission !== want) out = { ...out, [m.vehicle_id]: { ...v, mission: want } };
+  }
+  return out;
 }
 
 function withMission(state: State, m: Mission): State {
