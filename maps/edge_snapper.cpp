@@ -1,6 +1,7 @@
 #include "maps/edge_snapper.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <boost/geometry.hpp>
 #include <boost/geometry/index/rtree.hpp>
 #include <sstream>
@@ -68,6 +69,56 @@ SnapResult EdgeSnapper::snap(LatLon p, const SnapOptions& options) const {
         << ".." << hi.lat_deg << ", lon " << lo.lon_deg << ".." << hi.lon_deg;
     throw SnapError(SnapError::Reason::outside_map, msg.str());
   }
+}
+
+namespace {
+
+// The nearest point to p on segment ab, as the fraction t along it.
+double project(Point2 p, Point2 a, Point2 b) {
+  const double dx = b.x_m - a.x_m, dy = b.y_m - a.y_m;
+  const double len2 = dx * dx + dy * dy;
+  return len2 > 0.0 ? std::clamp(((p.x_m - a.x_m) * dx + (p.y_m - a.y_m) * dy) / len2, 0.0, 1.0) : 0.0;
+}
+
+}  // namespace
+
+std::vector<SnapResult> EdgeSnapper::candidates_local(Point2 p, double radius_m, std::size_t max_count) const {
+  std::vector<SnapResult> out;
+  if (!std::isfinite(p.x_m) || !std::isfinite(p.y_m) || !(radius_m > 0.0) || max_count == 0) return out;
+  const bg::model::box<BgPoint> box{{p.x_m - radius_m, p.y_m - radius_m}, {p.x_m + radius_m, p.y_m + radius_m}};
+  thread_local std::vector<std::pair<BgSegment, std::uint32_t>> found;
+  found.clear();
+  index_->tree.query(bgi::intersects(box), std::back_inserter(found));
+  for (const auto& [segment, piece_id] : found) {
+    const auto& piece = index_->pieces[piece_id];
+    const Point2 a{bg::get<0, 0>(segment), bg::get<0, 1>(segment)};
+    const Point2 b{bg::get<1, 0>(segment), bg::get<1, 1>(segment)};
+    const double t = project(p, a, b);
+    const Point2 q{a.x_m + t * (b.x_m - a.x_m), a.y_m + t * (b.y_m - a.y_m)};
+    const double d = distance_m(p, q);
+    if (d > radius_m) continue;
+    // One result per road: keep its nearest piece.
+    auto same = std::find_if(out.begin(), out.end(), [&](const SnapResult& r) { return r.edge == piece.edge; });
+    if (same != out.end() && same->distance_m <= d) continue;
+    SnapResult r;
+    r.edge = piece.edge;
+    r.point = q;
+    r.distance_m = d;
+    const double geometric = index_->geometric_length_m[r.edge.index()];
+    const double length = graph_.length_m(r.edge);
+    const double along = piece.start_along_m + t * distance_m(a, b);
+    r.offset_m = geometric > 0.0 ? std::clamp(along * length / geometric, 0.0, length) : 0.0;
+    r.twin = graph_.twin(r.edge);
+    if (r.twin.valid()) r.twin_offset_m = std::clamp(graph_.length_m(r.twin) - r.offset_m, 0.0, graph_.length_m(r.twin));
+    if (same != out.end()) {
+      *same = r;
+    } else {
+      out.push_back(r);
+    }
+  }
+  std::sort(out.begin(), out.end(), [](const SnapResult& x, const SnapResult& y) { return x.distance_m < y.distance_m; });
+  if (out.size() > max_count) out.resize(max_count);
+  return out;
 }
 
 SnapResult EdgeSnapper::snap_local(Point2 p, const SnapOptions& options) const {

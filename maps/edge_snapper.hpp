@@ -2,6 +2,7 @@
 #pragma once
 
 #include <memory>
+#include <vector>
 
 #include "maps/road_graph.hpp"
 
@@ -30,6 +31,11 @@ class EdgeSnapper {
   // Throws SnapError for an invalid coordinate, one outside the map, or one too far from any road.
   [[nodiscard]] SnapResult snap(LatLon p, const SnapOptions& options = {}) const;
   [[nodiscard]] SnapResult snap_local(Point2 p, const SnapOptions& options = {}) const;
+
+  // Every road within radius_m of p (local frame), nearest first, at most max_count roads; each
+  // result is the nearest point of one road (twin filled in as by snap). Empty when none is near
+  // or p is not finite. For map matching, which weighs several candidates rather than the nearest.
+  [[nodiscard]] std::vector<SnapResult> candidates_local(Point2 p, double radius_m, std::size_t max_count) const;
 
  private:
   struct Index;

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Module dependencies point one way: maps <- planner <- preemption <- sim/server; localizer <- maps.
+# Module dependencies point one way: maps <- planner <- preemption <- sim/server; maps <- planner
+# <- localizer <- sim/server.
 # A module may include only itself and the modules below it. Usage: layering_test.sh SOURCE_DIR
 set -euo pipefail
 cd "$1"
@@ -8,8 +9,8 @@ declare -A allowed=(
   [planner]="maps planner"
   [preemption]="maps planner preemption"
   [sim]="maps planner preemption sim"
-  [server]="maps planner preemption server"
-  [localizer]="maps localizer"
+  [server]="maps planner preemption localizer server"
+  [localizer]="maps planner localizer"
   [bench]="maps planner preemption server bench"
   [web]="web"
 )

@@ -1,0 +1,30 @@
+// A position fix as a receiver reports it, and a fix matched onto the road graph: the plain structs
+// the map matchers take and give.
+#pragma once
+
+#include <optional>
+
+#include "maps/geo.hpp"
+#include "maps/ids.hpp"
+
+namespace corridor::localizer {
+
+struct GpsFix {
+  double time_s = 0;  // seconds, any epoch, increasing along a trace
+  maps::LatLon position;
+  std::optional<double> hdop;         // horizontal dilution of precision (1 = ideal)
+  std::optional<double> heading_deg;  // course over ground, clockwise from north
+  std::optional<double> speed_mps;
+};
+
+struct MatchedPoint {
+  bool matched = false;  // false: no road near, or the chain broke here and nothing fits yet
+  EdgeId edge;
+  double offset_m = 0;       // along `edge`, in the edge's length units
+  maps::Point2 point;        // on the road, local frame
+  double distance_m = 0;     // from the raw fix to `point`
+  double confidence = 0;     // the chosen candidate's share of the step's probability, 0..1
+  bool chain_start = false;  // the first point after a break (gap, no candidate, impossible move)
+};
+
+}  // namespace corridor::localizer

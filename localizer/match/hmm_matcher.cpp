@@ -1,0 +1,233 @@
+#include "localizer/match/hmm_matcher.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+namespace corridor::localizer {
+namespace {
+
+constexpr double kNoScore = -std::numeric_limits<double>::infinity();
+
+double bearing_deg(const maps::RoadGraph& g, EdgeId e, double offset_m) {
+  const double len = g.length_m(e);
+  const maps::Point2 a = g.point_along(e, std::max(0.0, offset_m - 2.0));
+  const maps::Point2 b = g.point_along(e, std::min(len, offset_m + 2.0));
+  return std::atan2(b.x_m - a.x_m, b.y_m - a.y_m) * 180.0 / std::numbers::pi;
+}
+
+double angle_between_deg(double a, double b) {
+  const double d = std::fmod(std::abs(a - b), 360.0);
+  return d > 180.0 ? 360.0 - d : d;
+}
+
+}  // namespace
+
+void HmmConfig::validate() const {
+  if (!(sigma_base_m > 0.0) || !(default_hdop > 0.0) || !(beta_m > 0.0) || !(min_radius_m > 0.0) ||
+      !(max_radius_m >= min_radius_m) || !(max_speed_mps > 0.0) || !(gap_s > 0.0) || !(heading_sigma_deg > 0.0) ||
+      max_candidates == 0 || window == 0) {
+    throw std::invalid_argument("map matcher configuration needs positive scales, radii, speed, gap and window");
+  }
+}
+
+HmmMatcher::HmmMatcher(const maps::RoadGraph& graph, const maps::EdgeSnapper& snapper, HmmConfig config)
+    : graph_(graph), snapper_(snapper), config_(config), distances_(graph) {
+  config_.validate();
+}
+
+void HmmMatcher::reset() { window_.clear(); }
+
+std::vector<HmmMatcher::Candidate> HmmMatcher::candidates_for(const GpsFix& fix, maps::Point2 raw) const {
+  const double hdop = fix.hdop && std::isfinite(*fix.hdop) && *fix.hdop > 0.0 ? *fix.hdop : config_.default_hdop;
+  const double sigma = hdop * config_.sigma_base_m;
+  const double radius = std::clamp(config_.radius_sigmas * sigma, config_.min_radius_m, config_.max_radius_m);
+  const bool use_heading = fix.heading_deg && std::isfinite(*fix.heading_deg) &&
+                           (!fix.speed_mps || *fix.speed_mps >= config_.heading_min_speed_mps);
+  std::vector<Candidate> out;
+  for (const maps::SnapResult& road : snapper_.candidates_local(raw, radius, config_.max_candidates)) {
+    // Newson & Krumm's emission: a zero-mean Gaussian in the distance from the fix to the road.
+    const double emission = -0.5 * (road.distance_m / sigma) * (road.distance_m / sigma);
+    auto add = [&](EdgeId e, double offset) {
+      double score = emission;
+      if (use_heading) {
+        const double off = angle_between_deg(bearing_deg(graph_, e, offset), *fix.heading_deg) / config_.heading_sigma_deg;
+        score -= 0.5 * off * off;
+      }
+      out.push_back({e, offset, road.point, road.distance_m, score, -1});
+    };
+    add(road.edge, road.offset_m);
+    if (road.twin.valid()) add(road.twin, road.twin_offset_m);
+  }
+  return out;
+}
+
+bool HmmMatcher::link(const Step& prev, Step& next, const GpsFix& fix) {
+  const double dt = next.time_s - prev.time_s;
+  if (dt > config_.gap_s || dt < 0.0) return false;
+  const double straight = maps::distance_m(prev.raw, next.raw);
+  // No route can be longer than the fastest vehicle drives meanwhile; a generous detour budget
+  // keeps the searches small where fixes are dense.
+  const double bound = std::min(config_.max_speed_mps * std::max(dt, 1.0), 2.0 * straight + 300.0);
+  thread_local std::vector<NodeId> targets;
+  targets.clear();
+  for (const Candidate& c : next.candidates) targets.push_back(graph_.tail(c.edge));
+  std::sort(targets.begin(), targets.end());
+  targets.erase(std::unique(targets.begin(), targets.end()), targets.end());
+  const bool use_speed = fix.speed_mps && std::isfinite(*fix.speed_mps) && dt > 0.0;
+
+  for (Candidate& c : next.candidates) {
+    c.parent = -1;
+    c.score = c.score;  // emission, set by candidates_for
+  }
+  std::vector<double> best(next.candidates.size(), kNoScore);
+  bool any = false;
+  for (std::size_t i = 0; i < prev.candidates.size(); ++i) {
+    const Candidate& p = prev.candidates[i];
+    if (p.score == kNoScore) continue;
+    const double to_end = graph_.length_m(p.edge) - p.offset_m;
+    bool searched = false;
+    for (std::size_t j = 0; j < next.candidates.size(); ++j) {
+      const Candidate& c = next.candidates[j];
+      double route;
+      if (c.edge == p.edge && c.offset_m >= p.offset_m - config_.backward_tolerance_m) {
+        route = std::max(0.0, c.offset_m - p.offset_m);
+      } else {
+        if (!searched) {
+          distances_.run(graph_.head(p.edge), std::max(0.0, bound - to_end), targets);
+          searched = true;
+        }
+        const double between = distances_.length_m(graph_.tail(c.edge));
+        if (between == planner::kInfCost) continue;
+        route = to_end + between + c.offset_m;
+      }
+      if (route > bound || (dt > 0.0 && route / dt > config_.max_speed_mps)) continue;
+      // Newson & Krumm's transition: exponential in |route − straight line|.
+      double transition = -std::abs(route - straight) / config_.beta_m;
+      if (use_speed) transition -= std::abs(route - *fix.speed_mps * dt) / (2.0 * config_.beta_m);
+      const double score = p.score + transition;
+      if (score > best[j]) {
+        best[j] = score;
+        next.candidates[j].parent = static_cast<std::int32_t>(i);
+      }
+    }
+  }
+  for (std::size_t j = 0; j < next.candidates.size(); ++j) {
+    if (best[j] == kNoScore) {
+      next.candidates[j].score = kNoScore;
+    } else {
+      next.candidates[j].score += best[j];
+      any = true;
+    }
+  }
+  if (!any) return false;
+  // Keep the scores near zero: only their differences matter.
+  const double top = next.candidates[HmmMatcher::best(next)].score;
+  for (Candidate& c : next.candidates) {
+    if (c.score != kNoScore) c.score -= top;
+  }
+  return true;
+}
+
+std::size_t HmmMatcher::best(const Step& step) {
+  std::size_t b = 0;
+  for (std::size_t i = 1; i < step.candidates.size(); ++i) {
+    if (step.candidates[i].score > step.candidates[b].score) b = i;
+  }
+  return b;
+}
+
+MatchedPoint HmmMatcher::point_of(const Step& step, std::size_t index) const {
+  MatchedPoint m;
+  if (step.candidates.empty() || step.candidates[index].score == kNoScore) return m;
+  const Candidate& c = step.candidates[index];
+  m.matched = true;
+  m.edge = c.edge;
+  m.offset_m = c.offset_m;
+  m.point = c.point;
+  m.distance_m = c.distance_m;
+  m.chain_start = step.chain_start;
+  double total = 0.0;
+  for (const Candidate& o : step.candidates) {
+    if (o.score != kNoScore) total += std::exp(o.score - c.score);
+  }
+  m.confidence = total > 0.0 ? 1.0 / total : 0.0;
+  return m;
+}
+
+MatchedPoint HmmMatcher::update(const GpsFix& fix) {
+  if (!maps::is_valid_lat_lon(fix.position) || !std::isfinite(fix.time_s)) {
+    throw std::invalid_argument("a fix needs a finite time and a valid coordinate");
+  }
+  Step step;
+  step.time_s = fix.time_s;
+  step.raw = graph_.projection().to_local(fix.position);
+  step.candidates = candidates_for(fix, step.raw);
+  if (step.candidates.empty()) {
+    window_.clear();
+    MatchedPoint none;
+    none.distance_m = 0.0;
+    return none;
+  }
+  if (window_.empty() || !link(window_.back(), step, fix)) {
+    // A new chain: its first step is scored by the emission alone.
+    step = Step{fix.time_s, step.raw, candidates_for(fix, step.raw), true};
+    window_.clear();
+  }
+  window_.push_back(std::move(step));
+  while (window_.size() > config_.window) window_.pop_front();
+  const Step& now = window_.back();
+  return point_of(now, best(now));
+}
+
+std::vector<MatchedPoint> HmmMatcher::match(std::span<const GpsFix> trace) {
+  for (std::size_t i = 0; i < trace.size(); ++i) {
+    if (!maps::is_valid_lat_lon(trace[i].position) || !std::isfinite(trace[i].time_s)) {
+      throw std::invalid_argument("fix " + std::to_string(i + 1) + " needs a finite time and a valid coordinate");
+    }
+    if (i > 0 && trace[i].time_s < trace[i - 1].time_s) {
+      throw std::invalid_argument("fix " + std::to_string(i + 1) + " is earlier than the one before it: sort the trace by time");
+    }
+  }
+  std::vector<MatchedPoint> out(trace.size());
+  std::vector<Step> steps;
+  std::vector<std::size_t> fix_of;  // steps[k] came from trace[fix_of[k]]
+  // Backtracks the chain steps[first..steps.size()) from its best last candidate.
+  auto finish_chain = [&](std::size_t first) {
+    if (steps.size() <= first) return;
+    std::size_t k = steps.size() - 1;
+    std::int32_t at = static_cast<std::int32_t>(best(steps[k]));
+    while (true) {
+      out[fix_of[k]] = point_of(steps[k], static_cast<std::size_t>(at));
+      if (k == first) break;
+      at = steps[k].candidates[static_cast<std::size_t>(at)].parent;
+      --k;
+      if (at < 0) break;  // cannot happen inside a chain; stop rather than misread
+    }
+  };
+  std::size_t chain_first = 0;
+  for (std::size_t i = 0; i < trace.size(); ++i) {
+    Step step;
+    step.time_s = trace[i].time_s;
+    step.raw = graph_.projection().to_local(trace[i].position);
+    step.candidates = candidates_for(trace[i], step.raw);
+    if (step.candidates.empty()) {
+      finish_chain(chain_first);
+      chain_first = steps.size();
+      continue;  // out[i] stays unmatched
+    }
+    const bool linked = steps.size() > chain_first && link(steps.back(), step, trace[i]);
+    if (!linked) {
+      finish_chain(chain_first);
+      chain_first = steps.size();
+      step = Step{trace[i].time_s, step.raw, candidates_for(trace[i], step.raw), true};
+    }
+    steps.push_back(std::move(step));
+    fix_of.push_back(i);
+  }
+  finish_chain(chain_first);
+  return out;
+}
+
+}  // namespace corridor::localizer

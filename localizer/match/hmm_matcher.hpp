@@ -1,0 +1,85 @@
+// Online and batch HMM map matching (Newson & Krumm 2009) on the road graph. Candidates are road
+// points within a radius (the snapper's R-tree); the emission is Gaussian in the distance to the
+// road, with σ = HDOP × a base; the transition compares the network distance between consecutive
+// candidates (the planner's bounded one-to-many search) with the straight-line distance between
+// the fixes. Heading and speed, when a fix has them, weigh candidates and moves. Viterbi runs
+// incrementally, keeping a bounded window; a time gap, no candidate, or no possible move breaks
+// the chain, which restarts cleanly at the next fix.
+#pragma once
+
+#include <deque>
+#include <span>
+#include <vector>
+
+#include "localizer/match/gps_fix.hpp"
+#include "maps/edge_snapper.hpp"
+#include "planner/bounded_search.hpp"
+
+namespace corridor::localizer {
+
+struct HmmConfig {
+  double sigma_base_m = 4.0;      // σ of the emission = HDOP × this (Newson & Krumm: 4.07 m)
+  double default_hdop = 1.5;      // for fixes without HDOP
+  double min_radius_m = 30.0;     // candidates within max(this, radius_sigmas × σ)
+  double radius_sigmas = 4.0;
+  double max_radius_m = 200.0;
+  std::size_t max_candidates = 6;  // roads per fix (each two-way road gives two directed points)
+  double beta_m = 6.0;            // transition scale for |network − straight-line| (metres)
+  double max_speed_mps = 70.0;    // a move needing more is impossible
+  double gap_s = 60.0;            // fixes further apart in time break the chain
+  double heading_sigma_deg = 40.0;
+  double heading_min_speed_mps = 2.0;  // below this the course over ground is noise
+  double backward_tolerance_m = 8.0;   // noise may put a fix a little behind the last one on a road
+  std::size_t window = 8;         // online: steps kept (the lag bound)
+
+  // Throws std::invalid_argument for a non-positive scale or radius.
+  void validate() const;
+};
+
+class HmmMatcher {
+ public:
+  HmmMatcher(const maps::RoadGraph& graph, const maps::EdgeSnapper& snapper, HmmConfig config = {});
+
+  // Online: takes the next fix (time not before the last one's) and returns the best estimate of
+  // where the vehicle is now, given every fix so far in the chain.
+  MatchedPoint update(const GpsFix& fix);
+  // Forgets the chain (a vehicle teleported, a new trace).
+  void reset();
+
+  // Batch: the most likely sequence through a whole trace, one point per fix (breaks included).
+  // Throws std::invalid_argument when times decrease or a fix is not a finite coordinate.
+  std::vector<MatchedPoint> match(std::span<const GpsFix> trace);
+
+  [[nodiscard]] const HmmConfig& config() const { return config_; }
+
+ private:
+  struct Candidate {
+    EdgeId edge;
+    double offset_m;
+    maps::Point2 point;
+    double distance_m;
+    double score;         // log probability of the best path ending here
+    std::int32_t parent;  // index in the previous step, -1 at a chain start
+  };
+  struct Step {
+    double time_s;
+    maps::Point2 raw;
+    std::vector<Candidate> candidates;
+    bool chain_start = false;
+  };
+
+  // Candidates of a fix with their emission scores.
+  std::vector<Candidate> candidates_for(const GpsFix& fix, maps::Point2 raw) const;
+  // Links `next` to `prev` (scores and parents); false when no candidate can be reached.
+  bool link(const Step& prev, Step& next, const GpsFix& fix);
+  [[nodiscard]] MatchedPoint point_of(const Step& step, std::size_t index) const;
+  [[nodiscard]] static std::size_t best(const Step& step);
+
+  const maps::RoadGraph& graph_;
+  const maps::EdgeSnapper& snapper_;
+  HmmConfig config_;
+  planner::BoundedDistances distances_;
+  std::deque<Step> window_;
+};
+
+}  // namespace corridor::localizer

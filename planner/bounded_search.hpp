@@ -1,0 +1,39 @@
+// Bounded one-to-many shortest distances on the road graph, by length: Dijkstra from one node
+// until every target is settled or the bound is passed. The map matcher's transition model asks it
+// for the network distance between consecutive candidates. The arrays are kept between runs, so a
+// run costs what it visits.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "maps/road_graph.hpp"
+#include "planner/cost.hpp"
+
+namespace corridor::planner {
+
+class BoundedDistances {
+ public:
+  explicit BoundedDistances(const maps::RoadGraph& graph);
+
+  // Distances from `source` along the graph's edges, up to max_length_m; stops early once every
+  // node in `targets` is settled. Returns the number of nodes settled.
+  std::size_t run(NodeId source, double max_length_m, std::span<const NodeId> targets = {});
+
+  // After run(): the shortest length to v if the run settled it (every target within the bound
+  // is), else kInfCost.
+  [[nodiscard]] double length_m(NodeId v) const {
+    return settled_[v.index()] == round_ ? dist_[v.index()] : kInfCost;
+  }
+
+ private:
+  const maps::RoadGraph& graph_;
+  std::vector<double> dist_;
+  std::vector<std::uint32_t> stamp_;    // dist_ is valid where stamp_ == round_
+  std::vector<std::uint32_t> settled_;  // settled in the round stored here
+  std::vector<std::pair<double, std::uint32_t>> heap_;
+  std::uint32_t round_ = 0;
+};
+
+}  // namespace corridor::planner

@@ -1,0 +1,273 @@
+// The HMM map matcher against hand-built cases where nearest-road snapping goes wrong (a parallel
+// service road, an overpass, a U-turn, a roundabout), its breaks (a gap, nothing near), bad input,
+// and, as an oracle, noiseless and noisy drives along random routes whose true edges are known.
+#include "localizer/match/hmm_matcher.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <iostream>
+#include <numbers>
+#include <random>
+
+#include "maps/graph_builder.hpp"
+#include "maps/synthetic_grid.hpp"
+#include "planner/route.hpp"
+
+namespace corridor::localizer {
+namespace {
+
+// A graph from polylines in the local frame: each road is a list of node indices (two-way unless
+// one-way), with straight geometry between them.
+struct Sketch {
+  std::vector<maps::Point2> nodes;
+  struct Road {
+    std::vector<std::uint32_t> through;
+    bool oneway = false;
+    std::int64_t way = 0;
+  };
+  std::vector<Road> roads;
+
+  maps::RoadGraph build() const {
+    maps::GraphBuildInput in;
+    in.origin = {47.0, 9.5};
+    in.node_pos = nodes;
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+      in.node_osm.push_back(OsmNodeId{static_cast<std::int64_t>(i + 1)});
+      in.node_signalized.push_back(0);
+    }
+    for (const Road& r : roads) {
+      for (std::size_t k = 1; k < r.through.size(); ++k) {
+        maps::RoadSegment s;
+        s.from = r.through[k - 1];
+        s.to = r.through[k];
+        s.first_point = static_cast<std::uint32_t>(in.points.size());
+        in.points.push_back(nodes[s.from]);
+        in.points.push_back(nodes[s.to]);
+        s.last_point = s.first_point + 1;
+        s.forward = true;
+        s.backward = !r.oneway;
+        s.forward_speed_mps = s.backward_speed_mps = 14.0f;
+        s.way = OsmWayId{r.way};
+        in.segments.push_back(s);
+      }
+    }
+    return maps::build_road_graph(in);
+  }
+};
+
+GpsFix fix_at(const maps::RoadGraph& g, double t, maps::Point2 p, std::optional<double> heading = {},
+              std::optional<double> speed = {}) {
+  return {t, g.projection().to_lat_lon(p), 1.0, heading, speed};
+}
+
+std::int64_t way_of(const maps::RoadGraph& g, const MatchedPoint& m) { return m.matched ? g.osm_way(m.edge).v : -1; }
+
+// A main road with a service road 12 m beside it, joined at both ends. Fixes along the main road
+// drift 7 m towards the service road, nearer to it than to the main road for half the drive: a
+// nearest-road snap jumps across; the HMM stays, since the jump would need a route through the
+// joins far longer than the fixes moved.
+TEST(HmmMatcher, StaysOnTheMainRoadBesideAParallelServiceRoad) {
+  Sketch s;
+  s.nodes = {{0, 0}, {100, 0}, {900, 0}, {1000, 0}, {100, 12}, {900, 12}};
+  s.roads = {{{0, 1, 2, 3}, false, 1}, {{1, 4}, false, 2}, {{4, 5}, false, 3}, {{5, 2}, false, 2}};
+  const auto g = s.build();
+  const maps::EdgeSnapper snapper(g);
+  HmmMatcher matcher(g, snapper);
+  std::vector<GpsFix> trace;
+  for (int i = 0; i <= 60; ++i) {
+    const double x = 50.0 + i * 15.0;
+    const double y = (i % 2 == 0) ? 7.0 : 3.0;  // every other fix is nearer the service road
+    trace.push_back(fix_at(g, i * 1.0, {x, y}, 90.0, 15.0));
+  }
+  int on_main = 0, nearest_on_main = 0;
+  for (const MatchedPoint& m : matcher.match(trace)) on_main += way_of(g, m) == 1 ? 1 : 0;
+  for (const GpsFix& f : trace) nearest_on_main += g.osm_way(snapper.snap(f.position).edge).v == 1 ? 1 : 0;
+  EXPECT_EQ(on_main, 61);
+  EXPECT_LT(nearest_on_main, 61);  // the case is hard for the snap
+  // Online too, one fix at a time.
+  HmmMatcher online(g, snapper);
+  int online_main = 0;
+  for (const GpsFix& f : trace) online_main += way_of(g, online.update(f)) == 1 ? 1 : 0;
+  EXPECT_GE(online_main, 58);
+}
+
+// Road 1 runs east; road 2 crosses it on a bridge with no junction. Fixes where they cross are as
+// near to one as to the other; the HMM keeps the vehicle on the road it was driving.
+TEST(HmmMatcher, KeepsTheRoadThroughAnOverpass) {
+  Sketch s;
+  s.nodes = {{0, 0}, {1000, 0}, {500, -500}, {500, 500}};
+  s.roads = {{{0, 1}, false, 1}, {{2, 3}, false, 2}};
+  const auto g = s.build();
+  const maps::EdgeSnapper snapper(g);
+  HmmMatcher matcher(g, snapper);
+  std::vector<GpsFix> trace;
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> noise(0.0, 4.0);
+  for (int i = 0; i <= 50; ++i) trace.push_back(fix_at(g, i, {250.0 + i * 10.0 + noise(rng), noise(rng)}));
+  for (const MatchedPoint& m : matcher.match(trace)) EXPECT_EQ(way_of(g, m), 1);
+}
+
+// East along a two-way street, then back west: the direction of travel flips with the U-turn.
+TEST(HmmMatcher, FollowsAUTurnOnATwoWayStreet) {
+  Sketch s;
+  s.nodes = {{0, 0}, {400, 0}, {800, 0}};
+  s.roads = {{{0, 1, 2}, false, 1}};
+  const auto g = s.build();
+  const maps::EdgeSnapper snapper(g);
+  HmmMatcher matcher(g, snapper);
+  std::vector<GpsFix> trace;
+  for (int i = 0; i <= 20; ++i) trace.push_back(fix_at(g, i, {100.0 + i * 20.0, 2.0}, 90.0, 20.0));
+  for (int i = 1; i <= 20; ++i) trace.push_back(fix_at(g, 20 + i, {500.0 - i * 20.0, 2.0}, 270.0, 20.0));
+  const auto matched = matcher.match(trace);
+  auto heading_east = [&](const MatchedPoint& m) { return g.position(g.head(m.edge)).x_m > g.position(g.tail(m.edge)).x_m; };
+  for (int i = 0; i <= 18; ++i) EXPECT_TRUE(heading_east(matched[static_cast<std::size_t>(i)])) << i;
+  for (std::size_t i = 23; i < matched.size(); ++i) EXPECT_FALSE(heading_east(matched[i])) << i;
+}
+
+// A one-way roundabout (radius 30 m, counter-clockwise) with four arms: the vehicle enters from the
+// west and leaves by the east arm; every fix on the ring is matched to the ring, in its direction.
+TEST(HmmMatcher, GoesRoundARoundabout) {
+  Sketch s;
+  const int ring = 12;
+  for (int k = 0; k < ring; ++k) {
+    const double a = std::numbers::pi + 2.0 * std::numbers::pi * k / ring;  // from the west, counter-clockwise seen from above
+    s.nodes.push_back({30.0 * std::cos(-a), 30.0 * std::sin(-a)});
+  }
+  Sketch::Road r{{}, true, 9};
+  for (int k = 0; k <= ring; ++k) r.through.push_back(static_cast<std::uint32_t>(k % ring));
+  s.roads.push_back(r);
+  const auto arm = [&](std::uint32_t ring_node, maps::Point2 far, std::int64_t way) {
+    s.nodes.push_back(far);
+    s.roads.push_back({{static_cast<std::uint32_t>(s.nodes.size() - 1), ring_node}, false, way});
+  };
+  arm(0, {-300, 0}, 1);
+  arm(3, {0, -300}, 2);
+  arm(6, {300, 0}, 3);
+  arm(9, {0, 300}, 4);
+  const auto g = s.build();
+  const maps::EdgeSnapper snapper(g);
+  HmmMatcher matcher(g, snapper);
+  std::vector<GpsFix> trace;
+  double t = 0;
+  for (double x = -250; x <= -40; x += 15) trace.push_back(fix_at(g, t++, {x, 1.5}));
+  // Half way round, through the south (the ring's node 3) to the east (node 6).
+  for (int k = 1; k < 6; ++k) {
+    const double a = std::numbers::pi + 2.0 * std::numbers::pi * (k + 0.5) / ring;
+    trace.push_back(fix_at(g, t++, {31.0 * std::cos(-a), 31.0 * std::sin(-a)}));
+  }
+  for (double x = 45; x <= 250; x += 15) trace.push_back(fix_at(g, t++, {x, -1.5}));
+  const auto matched = matcher.match(trace);
+  std::vector<std::int64_t> ways;
+  for (const auto& m : matched) {
+    if (ways.empty() || ways.back() != way_of(g, m)) ways.push_back(way_of(g, m));
+  }
+  EXPECT_EQ(ways, (std::vector<std::int64_t>{1, 9, 3}));
+  // The east arm is driven outward.
+  EXPECT_GT(g.position(g.head(matched.back().edge)).x_m, g.position(g.tail(matched.back().edge)).x_m);
+}
+
+TEST(HmmMatcher, AGapOrNothingNearBreaksTheChainAndItRestarts) {
+  Sketch s;
+  s.nodes = {{0, 0}, {2000, 0}};
+  s.roads = {{{0, 1}, false, 1}};
+  const auto g = s.build();
+  const maps::EdgeSnapper snapper(g);
+  HmmMatcher matcher(g, snapper);
+  std::vector<GpsFix> trace;
+  for (int i = 0; i < 5; ++i) trace.push_back(fix_at(g, i, {100.0 + i * 10, 1.0}));
+  trace.push_back(fix_at(g, 5, {150, 900}));            // nothing within reach
+  trace.push_back(fix_at(g, 6, {160, 1.0}));            // starts a new chain
+  trace.push_back(fix_at(g, 300, {170, 1.0}));          // a 294 s gap
+  trace.push_back(fix_at(g, 301, {180, 1.0}));
+  const auto m = matcher.match(trace);
+  EXPECT_TRUE(m[0].chain_start);
+  EXPECT_FALSE(m[4].chain_start);
+  EXPECT_FALSE(m[5].matched);
+  EXPECT_TRUE(m[6].matched && m[6].chain_start);
+  EXPECT_TRUE(m[7].matched && m[7].chain_start);
+  EXPECT_TRUE(m[8].matched && !m[8].chain_start);
+  // Online the same.
+  HmmMatcher online(g, snapper);
+  std::vector<MatchedPoint> live;
+  for (const GpsFix& f : trace) live.push_back(online.update(f));
+  EXPECT_FALSE(live[5].matched);
+  EXPECT_TRUE(live[6].chain_start);
+  EXPECT_TRUE(live[7].chain_start);
+  EXPECT_FALSE(live[8].chain_start);
+}
+
+TEST(HmmMatcher, RejectsUnsortedTimesAndNonFiniteFixes) {
+  Sketch s;
+  s.nodes = {{0, 0}, {500, 0}};
+  s.roads = {{{0, 1}, false, 1}};
+  const auto g = s.build();
+  const maps::EdgeSnapper snapper(g);
+  HmmMatcher matcher(g, snapper);
+  std::vector<GpsFix> unsorted{fix_at(g, 5, {10, 0}), fix_at(g, 4, {20, 0})};
+  EXPECT_THROW(matcher.match(unsorted), std::invalid_argument);
+  GpsFix nan = fix_at(g, 1, {10, 0});
+  nan.position.lat_deg = std::nan("");
+  EXPECT_THROW(matcher.update(nan), std::invalid_argument);
+  EXPECT_THROW(HmmMatcher(g, snapper, HmmConfig{.beta_m = 0.0}), std::invalid_argument);
+  // A trace entirely off the map matches nothing, without error.
+  const std::vector<GpsFix> far{fix_at(g, 0, {0, 5000}), fix_at(g, 1, {10, 5000})};
+  for (const auto& m : matcher.match(far)) EXPECT_FALSE(m.matched);
+}
+
+// Oracle: drives along random shortest routes of random grids, one fix a second at 12 m/s, with
+// Gaussian noise of σ 5 m. The matched edge must be the driven one for nearly every fix, and far
+// more often than the nearest road is.
+TEST(HmmMatcher, RecoversTheDrivenEdgesOfRandomRoutes) {
+  std::size_t total = 0, correct = 0, nearest_correct = 0;
+  for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+    maps::GridSpec spec;
+    spec.rows = 10;
+    spec.cols = 10;
+    spec.seed = seed;
+    spec.spacing_m = 150.0;
+    const auto g = maps::make_perturbed_grid(spec);
+    const maps::EdgeSnapper snapper(g);
+    HmmMatcher matcher(g, snapper);
+    std::mt19937_64 rng(seed);
+    std::normal_distribution<double> noise(0.0, 5.0);
+    // A random walk that never turns straight back: its edges are the truth.
+    std::vector<EdgeId> walk;
+    EdgeId e{static_cast<std::uint32_t>(rng() % g.edge_count())};
+    for (int k = 0; k < 40; ++k) {
+      walk.push_back(e);
+      std::vector<EdgeId> next;
+      for (EdgeId o : g.out_edges(g.head(e))) {
+        if (o != g.twin(e)) next.push_back(o);
+      }
+      if (next.empty()) break;
+      e = next[rng() % next.size()];
+    }
+    std::vector<GpsFix> trace;
+    std::vector<EdgeId> truth;
+    double t = 0, along = 5.0;
+    for (EdgeId w : walk) {
+      for (; along < g.length_m(w); along += 12.0, t += 1.0) {
+        const maps::Point2 p = g.point_along(w, along);
+        trace.push_back(fix_at(g, t, {p.x_m + noise(rng), p.y_m + noise(rng)}));
+        truth.push_back(w);
+      }
+      along -= g.length_m(w);
+    }
+    const auto matched = matcher.match(trace);
+    for (std::size_t i = 0; i < trace.size(); ++i) {
+      ++total;
+      correct += matched[i].matched && matched[i].edge == truth[i] ? 1 : 0;
+      nearest_correct += snapper.snap(trace[i].position).edge == truth[i] ? 1 : 0;
+    }
+  }
+  ASSERT_GT(total, 500u);
+  const double share = static_cast<double>(correct) / static_cast<double>(total);
+  const double nearest = static_cast<double>(nearest_correct) / static_cast<double>(total);
+  std::cout << "hmm correct " << share << " nearest " << nearest << " over " << total << " fixes\n";
+  EXPECT_GE(share, 0.95) << "correct " << correct << " of " << total;
+  EXPECT_GT(share, nearest + 0.1) << "nearest-road snap " << nearest;
+}
+
+}  // namespace
+}  // namespace corridor::localizer
