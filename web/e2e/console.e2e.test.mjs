@@ -307,6 +307,40 @@ describe('dispatch console (Monaco)', () => {
     await shot(page, 'mission-cancelled');
   });
 
+  it('shows the server\'s reason when a vehicle has no known position, and dispatches it from a clicked origin', async () => {
+    const { page } = dispatcher;
+    const problemsBefore = dispatcher.problems.length;
+    await page.getByTestId('vehicle-input').fill('amb-3');
+    await zoomAt(page, DESTINATION.lat, DESTINATION.lon, 0);
+    const d = await stablePoint(page, DESTINATION.lat, DESTINATION.lon);
+    await page.mouse.click(d.x, d.y);
+    await page.getByTestId('create-mission').click();
+    await waitFor('the refusal', async () => (await page.getByTestId('dispatch-error').innerText()).length > 0);
+    const refusal = await page.getByTestId('dispatch-error').innerText();
+    assert.match(refusal, /^[a-z_]+: .+/);
+    // The browser logs the refused request itself; that one is expected.
+    const logged = dispatcher.problems.splice(problemsBefore);
+    dispatcher.problems.push(...logged.filter((p) => !/status of 422/.test(p)));
+    // "Set origin", then a click on the map puts the origin there.
+    await page.getByTestId('set-origin').click();
+    const o = await stablePoint(page, ORIGIN.lat, ORIGIN.lon);
+    await page.mouse.click(o.x, o.y);
+    await page.getByTestId('origin-pin').waitFor();
+    const [lat, lon] = (await page.getByTestId('origin-text').innerText()).split(',').map(Number);
+    assert.ok(metres([lon, lat], [ORIGIN.lon, ORIGIN.lat]) < 20);
+    await page.getByTestId('create-mission').click();
+    await waitFor('the mission of amb-3', async () =>
+      page.evaluate(() => Object.values(window.__corridor.state().missions).find((m) => m.vehicle_id === 'amb-3' && m.state === 'active')?.id ?? null),
+    );
+    assert.equal(await page.getByTestId('dispatch-error').innerText(), '');
+    const id = await page.evaluate(() => Object.values(window.__corridor.state().missions).find((m) => m.vehicle_id === 'amb-3').id);
+    const created = (await api(server.url, 'GET', `/v1/missions/${id}`)).json;
+    assert.ok(metres(created.route.geometry.coordinates[0], [ORIGIN.lon, ORIGIN.lat]) < 60, 'the route starts at the clicked origin');
+    await shot(page, 'origin-by-click');
+    await api(server.url, 'POST', `/v1/missions/${id}/cancel`);
+    console.log(`refused without an origin: ${refusal}`);
+  });
+
   it('shows a viewer no dispatch or congestion controls, and a sensor only congestion', async () => {
     const viewer = await signIn(browser, base, VIEWER_TOKEN);
     assert.ok(await viewer.page.getByTestId('dispatch-panel').isHidden());
