@@ -1,5 +1,7 @@
 #include "app/bench_command.hpp"
 
+#include "app/match_command.hpp"
+
 #include <cmath>
 #include <iostream>
 #include <memory>
@@ -44,6 +46,7 @@ void run_replan(const ReplanOptions& o) {
 
 void register_bench_command(CLI::App& app) {
   auto* bench_cmd = app.add_subcommand("bench", "Benchmarks that print JSON");
+  register_match_bench(*bench_cmd);
   bench_cmd->require_subcommand(1);
   auto o = std::make_shared<ReplanOptions>();
   auto* replan = bench_cmd->add_subcommand("replan", "D* Lite repair vs A*/Dijkstra from scratch while driving");

@@ -9,6 +9,7 @@
 #include "app/cli_error.hpp"
 #include "app/experiment_command.hpp"
 #include "app/map_command.hpp"
+#include "app/match_command.hpp"
 #include "app/preemption_command.hpp"
 #include "app/route_command.hpp"
 #include "app/serve_command.hpp"
@@ -35,6 +36,7 @@ int main(int argc, char** argv) {
   corridor::app::register_experiment_command(app);
   corridor::app::register_sim_command(app);
   corridor::app::register_vo_command(app);
+  corridor::app::register_match_command(app);
 
   try {
     app.parse(argc, argv);

@@ -46,6 +46,21 @@ double bearing_deg(const maps::RoadGraph& g, EdgeId e, double offset_m) {
   return std::fmod(std::atan2(b.x_m - a.x_m, b.y_m - a.y_m) * 180.0 / M_PI + 360.0, 360.0);
 }
 
+DispatchEvent position_event(const PositionReport& p, double now_s, MissionId mission, std::optional<double> eta_s) {
+  DispatchEvent e;
+  e.kind = "position";
+  e.mission = mission;
+  e.reason = p.source;
+  e.time_s = now_s;
+  e.vehicle_id = p.vehicle_id;
+  e.position = p.position;
+  e.heading_deg = p.heading_deg;
+  e.speed_mps = p.speed_mps;
+  e.source = p.source;
+  e.eta_s = eta_s;
+  return e;
+}
+
 double angle_between_deg(double a, double b) {
   const double d = std::fmod(std::abs(a - b), 360.0);
   return d > 180.0 ? 360.0 - d : d;
@@ -503,6 +518,7 @@ PositionResult DispatchService::report_position(const PositionReport& p, double 
   if (!mp) {
     stage(staged, [p, now_s](Store& store) { store.insert_position(p, std::nullopt, now_s); });
     result.durable = submit(staged);
+    emit(position_event(p, now_s, 0, std::nullopt));  // a free vehicle moves on the console too
     return result;
   }
   Mission& m = *mp;
@@ -526,18 +542,7 @@ PositionResult DispatchService::report_position(const PositionReport& p, double 
   const std::string reason = repair(m, &points).value_or("off_route");
   result.eta_s = m.route.travel_time_s;
   m.route_time_s = now_s;
-  DispatchEvent moved;
-  moved.kind = "position";
-  moved.mission = m.row.id;
-  moved.reason = p.source;
-  moved.time_s = now_s;
-  moved.vehicle_id = p.vehicle_id;
-  moved.position = p.position;
-  moved.heading_deg = p.heading_deg;
-  moved.speed_mps = p.speed_mps;
-  moved.source = p.source;
-  if (m.route.found) moved.eta_s = m.route.travel_time_s;
-  emit(std::move(moved));
+  emit(position_event(p, now_s, m.row.id, m.route.found ? std::optional<double>(m.route.travel_time_s) : std::nullopt));
   if (!m.route.found || m.route.length_m <= config_.arrival_radius_m ||
       maps::distance_m(snap.point, m.destination_local) <= config_.arrival_radius_m) {
     result.completed = true;

@@ -1,0 +1,228 @@
+#include "app/match_command.hpp"
+
+#include <chrono>
+#include <fstream>
+#include <iostream>
+#include <memory>
+
+#include <nlohmann/json.hpp>
+
+#include "app/cli_error.hpp"
+#include "app/map_options.hpp"
+#include "localizer/match/hmm_matcher.hpp"
+#include "localizer/match/synthetic_trace.hpp"
+#include "localizer/match/trace_io.hpp"
+#include "planner/route.hpp"
+
+namespace corridor::app {
+namespace {
+
+using nlohmann::json;
+
+struct MatchOptions {
+  MapOptions map;
+  std::string trace;
+  std::string out;
+  bool json = false;
+};
+
+double round7(double v) { return std::round(v * 1e7) / 1e7; }
+
+json lon_lat(const maps::RoadGraph& g, maps::Point2 p) {
+  const maps::LatLon ll = g.projection().to_lat_lon(p);
+  return json::array({round7(ll.lon_deg), round7(ll.lat_deg)});
+}
+
+// The matched path through consecutive matched points: along the edge, or from one edge's point to
+// its end and on from the next edge's start where they meet; a break starts a new line.
+json matched_route(const maps::RoadGraph& g, const std::vector<localizer::MatchedPoint>& points) {
+  json lines = json::array();
+  json line = json::array();
+  const localizer::MatchedPoint* prev = nullptr;
+  auto close = [&] {
+    if (line.size() >= 2) lines.push_back(line);
+    line = json::array();
+  };
+  for (const auto& m : points) {
+    if (!m.matched) {
+      close();
+      prev = nullptr;
+      continue;
+    }
+    if (m.chain_start) close();
+    if (line.empty() || prev == nullptr) {
+      line.push_back(lon_lat(g, g.point_along(m.edge, m.offset_m)));
+    } else if (prev->edge == m.edge && m.offset_m >= prev->offset_m) {
+      for (const auto& p : planner::edge_polyline(g, m.edge, prev->offset_m, m.offset_m)) line.push_back(lon_lat(g, p));
+    } else {
+      for (const auto& p : planner::edge_polyline(g, prev->edge, prev->offset_m, g.length_m(prev->edge))) line.push_back(lon_lat(g, p));
+      for (const auto& p : planner::edge_polyline(g, m.edge, 0.0, m.offset_m)) line.push_back(lon_lat(g, p));
+    }
+    prev = &m;
+  }
+  close();
+  if (lines.size() == 1) return {{"type", "LineString"}, {"coordinates", lines[0]}};
+  return {{"type", "MultiLineString"}, {"coordinates", lines}};
+}
+
+void run_match(const MatchOptions& o) {
+  const maps::RoadGraph graph = load_map_from_options(o.map);
+  const std::vector<localizer::GpsFix> trace = localizer::read_trace(o.trace);
+  const maps::EdgeSnapper snapper(graph);
+  localizer::HmmMatcher matcher(graph, snapper);
+  const auto started = std::chrono::steady_clock::now();
+  const auto matched = matcher.match(trace);
+  const double took_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+
+  json points = json::array();
+  json way_names = json::array();
+  std::size_t matched_count = 0;
+  for (std::size_t i = 0; i < matched.size(); ++i) {
+    const auto& m = matched[i];
+    json p{{"time_s", trace[i].time_s}, {"matched", m.matched}};
+    if (m.matched) {
+      ++matched_count;
+      const maps::LatLon at = graph.projection().to_lat_lon(m.point);
+      p["lat"] = round7(at.lat_deg);
+      p["lon"] = round7(at.lon_deg);
+      p["edge"] = m.edge.v;
+      p["osm_way_id"] = graph.osm_way(m.edge).v;
+      p["name"] = graph.name(m.edge);
+      p["offset_m"] = std::round(m.offset_m * 100.0) / 100.0;
+      p["distance_m"] = std::round(m.distance_m * 100.0) / 100.0;
+      p["confidence"] = std::round(m.confidence * 1000.0) / 1000.0;
+      const std::string name(graph.name(m.edge));
+      if (!name.empty() && (way_names.empty() || way_names.back() != name)) way_names.push_back(name);
+    } else {
+      p["lat"] = trace[i].position.lat_deg;
+      p["lon"] = trace[i].position.lon_deg;
+      p["edge"] = nullptr;
+      p["osm_way_id"] = nullptr;
+      p["name"] = nullptr;
+      p["offset_m"] = nullptr;
+      p["distance_m"] = nullptr;
+    }
+    points.push_back(std::move(p));
+  }
+  const json route = matched_route(graph, matched);
+  const double per_s = took_s > 0.0 ? static_cast<double>(trace.size()) / took_s : 0.0;
+  if (!o.out.empty()) {
+    std::ofstream out(o.out);
+    if (!out) throw UsageError("cannot write --out '" + o.out + "'");
+    out << json{{"type", "Feature"}, {"geometry", route}, {"properties", {{"fixes", trace.size()}, {"matched", matched_count}}}}.dump()
+        << '\n';
+  }
+  if (o.json) {
+    std::cout << json{{"points", std::move(points)},
+                      {"way_names", way_names},
+                      {"route", route},
+                      {"fixes", trace.size()},
+                      {"matched", matched_count},
+                      {"points_per_s", per_s}}
+                     .dump()
+              << '\n';
+    return;
+  }
+  std::cout << matched_count << " of " << trace.size() << " fixes matched (" << static_cast<long>(per_s) << " fixes/s)\n";
+  std::cout << "streets:";
+  for (const auto& n : way_names) std::cout << " " << n.get<std::string>() << " →";
+  std::cout << (way_names.empty() ? " (unnamed)\n" : " end\n");
+}
+
+struct MatchBenchOptions {
+  MapOptions map;
+  int drives = 20;
+  std::size_t edges = 60;
+  double noise_m = 5.0;
+  double outliers = 0.0;
+  std::uint64_t seed = 1;
+};
+
+void run_match_bench(const MatchBenchOptions& o) {
+  if (o.drives < 1 || o.edges < 2) throw UsageError("--drives must be at least 1 and --edges at least 2");
+  if (!(o.noise_m >= 0.0) || !(o.outliers >= 0.0 && o.outliers <= 1.0)) {
+    throw UsageError("--noise-m must be >= 0 and --outliers within [0, 1]");
+  }
+  const maps::RoadGraph graph = load_map_from_options(o.map);
+  const maps::EdgeSnapper snapper(graph);
+  std::vector<localizer::SyntheticTrace> traces;
+  for (int d = 0; d < o.drives; ++d) {
+    localizer::SyntheticTraceSpec spec;
+    spec.edges = o.edges;
+    spec.noise_sigma_m = o.noise_m;
+    spec.outlier_share = o.outliers;
+    spec.seed = o.seed + static_cast<std::uint64_t>(d);
+    traces.push_back(localizer::make_synthetic_trace(graph, spec));
+  }
+  std::size_t fixes = 0, correct = 0, nearest_correct = 0, matched = 0;
+  double batch_s = 0.0, online_s = 0.0, sq_err = 0.0, sq_raw = 0.0, sq_nearest = 0.0, length_total = 0.0, length_correct = 0.0;
+  for (const auto& t : traces) {
+    localizer::HmmMatcher batch(graph, snapper);
+    auto started = std::chrono::steady_clock::now();
+    const auto result = batch.match(t.fixes);
+    batch_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    localizer::HmmMatcher online(graph, snapper);
+    started = std::chrono::steady_clock::now();
+    for (const auto& f : t.fixes) (void)online.update(f);
+    online_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    for (std::size_t i = 0; i < t.fixes.size(); ++i) {
+      ++fixes;
+      const maps::Point2 raw = graph.projection().to_local(t.fixes[i].position);
+      sq_raw += std::pow(maps::distance_m(raw, t.truth_point[i]), 2);
+      const auto near = snapper.snap_local(raw);
+      nearest_correct += near.edge == t.truth[i] ? 1 : 0;
+      sq_nearest += std::pow(maps::distance_m(near.point, t.truth_point[i]), 2);
+      const double weight = 1.0;  // fixes are evenly spaced in distance: by time is by length
+      length_total += weight;
+      if (result[i].matched) {
+        ++matched;
+        sq_err += std::pow(maps::distance_m(result[i].point, t.truth_point[i]), 2);
+        if (result[i].edge == t.truth[i]) {
+          ++correct;
+          length_correct += weight;
+        }
+      }
+    }
+  }
+  const double n = static_cast<double>(fixes);
+  json out{{"map", o.map.map_file.empty() ? "embedded" : o.map.map_file},
+           {"drives", o.drives},
+           {"fixes", fixes},
+           {"noise_sigma_m", o.noise_m},
+           {"outlier_share", o.outliers},
+           {"matched_share", static_cast<double>(matched) / n},
+           {"correct_edge_share", static_cast<double>(correct) / n},
+           {"nearest_edge_correct_share", static_cast<double>(nearest_correct) / n},
+           {"rmse_raw_m", std::sqrt(sq_raw / n)},
+           {"rmse_nearest_m", std::sqrt(sq_nearest / n)},
+           {"rmse_matched_m", matched > 0 ? std::sqrt(sq_err / static_cast<double>(matched)) : 0.0},
+           {"batch_fixes_per_s", batch_s > 0.0 ? n / batch_s : 0.0},
+           {"online_fixes_per_s", online_s > 0.0 ? n / online_s : 0.0}};
+  std::cout << out.dump(2) << '\n';
+}
+
+}  // namespace
+
+void register_match_command(CLI::App& app) {
+  auto o = std::make_shared<MatchOptions>();
+  auto* cmd = app.add_subcommand("match", "Map-match a GPS trace (GPX, or CSV time,lat,lon[,hdop,heading_deg,speed_mps])");
+  add_map_options(*cmd, o->map);
+  cmd->add_option("--trace", o->trace, "GPX or CSV trace")->required();
+  cmd->add_flag("--json", o->json, "print points, way_names, route and points_per_s as JSON");
+  cmd->add_option("--out", o->out, "write the matched route as a GeoJSON Feature");
+  cmd->callback([o] { run_match(*o); });
+}
+
+void register_match_bench(CLI::App& bench) {
+  auto o = std::make_shared<MatchBenchOptions>();
+  auto* cmd = bench.add_subcommand("match", "HMM map matching on synthetic noisy drives: fixes/s, correct edges, RMSE");
+  add_map_options(*cmd, o->map);
+  cmd->add_option("--drives", o->drives, "drives (random walks)")->capture_default_str();
+  cmd->add_option("--edges", o->edges, "edges per drive")->capture_default_str();
+  cmd->add_option("--noise-m", o->noise_m, "GPS noise σ in metres")->capture_default_str();
+  cmd->add_option("--outliers", o->outliers, "share of multipath outliers (60 m off)")->capture_default_str();
+  cmd->add_option("--seed", o->seed, "first drive's seed")->capture_default_str();
+  cmd->callback([o] { run_match_bench(*o); });
+}
+
+}  // namespace corridor::app
