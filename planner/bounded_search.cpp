@@ -2,13 +2,16 @@
 
 #include <algorithm>
 #include <functional>
+#include <stdexcept>
 
 namespace corridor::planner {
 
-BoundedDistances::BoundedDistances(const maps::RoadGraph& graph)
-    : graph_(graph), dist_(graph.node_count(), kInfCost), stamp_(graph.node_count(), 0), settled_(graph.node_count(), 0) {}
+BoundedDistances::BoundedDistances(std::size_t node_count)
+    : dist_(node_count, kInfCost), stamp_(node_count, 0), settled_(node_count, 0) {}
 
-std::size_t BoundedDistances::run(NodeId source, double max_length_m, std::span<const NodeId> targets) {
+std::size_t BoundedDistances::run(const maps::RoadGraph& graph_, NodeId source, double max_length_m,
+                                  std::span<const NodeId> targets) {
+  if (graph_.node_count() != dist_.size()) throw std::invalid_argument("search arrays sized for another graph");
   if (++round_ == 0) {  // stamp wrap-around: start afresh
     std::fill(stamp_.begin(), stamp_.end(), 0);
     std::fill(settled_.begin(), settled_.end(), 0);

@@ -15,11 +15,13 @@ namespace corridor::planner {
 
 class BoundedDistances {
  public:
-  explicit BoundedDistances(const maps::RoadGraph& graph);
+  // Scratch arrays for a graph of this many nodes; any graph of that size may be searched with them.
+  explicit BoundedDistances(std::size_t node_count);
 
   // Distances from `source` along the graph's edges, up to max_length_m; stops early once every
   // node in `targets` is settled. Returns the number of nodes settled.
-  std::size_t run(NodeId source, double max_length_m, std::span<const NodeId> targets = {});
+  std::size_t run(const maps::RoadGraph& graph, NodeId source, double max_length_m, std::span<const NodeId> targets = {});
+  [[nodiscard]] std::size_t node_count() const { return dist_.size(); }
 
   // After run(): the shortest length to v if the run settled it (every target within the bound
   // is), else kInfCost.
@@ -28,7 +30,6 @@ class BoundedDistances {
   }
 
  private:
-  const maps::RoadGraph& graph_;
   std::vector<double> dist_;
   std::vector<std::uint32_t> stamp_;    // dist_ is valid where stamp_ == round_
   std::vector<std::uint32_t> settled_;  // settled in the round stored here

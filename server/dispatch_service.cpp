@@ -77,6 +77,7 @@ DispatchService::DispatchService(const maps::RoadGraph& graph, std::unordered_ma
       config_(config),
       store_(store),
       snapper_(graph),
+      tracker_(graph, snapper_),
       plans_(std::move(plans)),
       overlay_(graph),
       signals_(plans_, now_s),
@@ -493,14 +494,34 @@ PositionResult DispatchService::report_position(const PositionReport& p, double 
   }
   if (p.hdop && !(std::isfinite(*p.hdop) && *p.hdop >= 0.0)) throw bad_request("hdop must be a number >= 0");
   if (!std::isfinite(p.timestamp_s)) throw bad_request("timestamp must be a finite number of seconds");
+  // Off the map is bad input whatever else the report is: checked before the tracker.
   maps::SnapResult snap;
   try {
     snap = snapper_.snap(p.position, {config_.snap_max_distance_m});
   } catch (const maps::SnapError& e) {
     throw snap_error(e, "position");
   }
-
   PositionResult result;
+  // The tracker first, alone: a stale, duplicate or outlying report, or GPS too poor to follow, is
+  // stored as received and moves nothing.
+  const TrackResult tracked = tracker_.track(p);
+  result.match.disposition = to_string(tracked.disposition);
+  if (tracked.disposition != Disposition::followed) {
+    Staged staged;
+    stage(staged, [p, now_s, match = result.match](Store& store) { store.insert_position(p, std::nullopt, now_s, match); });
+    result.durable = submit(staged);
+    return result;
+  }
+  if (tracked.match.matched) {
+    // The matcher's point: the road and direction the vehicle's recent fixes say it drives.
+    snap.edge = tracked.match.edge;
+    snap.offset_m = tracked.match.offset_m;
+    snap.point = tracked.match.point;
+    snap.distance_m = tracked.match.distance_m;
+    result.match.edge = tracked.match.edge;
+    result.match.offset_m = tracked.match.offset_m;
+    result.match.confidence = tracked.match.confidence;
+  }
   result.snap_distance_m = snap.distance_m;
   MissionPtr mp;
   {
@@ -516,18 +537,20 @@ PositionResult DispatchService::report_position(const PositionReport& p, double 
     if (mp->row.state != MissionState::active) mp.reset();  // it ended in between
   }
   if (!mp) {
-    stage(staged, [p, now_s](Store& store) { store.insert_position(p, std::nullopt, now_s); });
+    stage(staged, [p, now_s, match = result.match](Store& store) { store.insert_position(p, std::nullopt, now_s, match); });
     result.durable = submit(staged);
     emit(position_event(p, now_s, 0, std::nullopt));  // a free vehicle moves on the console too
     return result;
   }
   Mission& m = *mp;
   result.mission = m.row.id;
-  stage(staged, [p, id = m.row.id, now_s](Store& store) { store.insert_position(p, id, now_s); });
+  stage(staged, [p, id = m.row.id, now_s, match = result.match](Store& store) { store.insert_position(p, id, now_s, match); });
   m.last_position = p.position;
 
-  // Signals behind the vehicle: every intersection of the old route before its current edge.
-  const auto points = endpoints(snap, Role::start, p.heading_deg);
+  // Signals behind the vehicle: every intersection of the old route before its current edge. A
+  // matched point already knows its direction; a raw snap asks the heading.
+  const auto points = tracked.match.matched ? std::vector<planner::EdgePoint>{{snap.edge, snap.offset_m}}
+                                            : endpoints(snap, Role::start, p.heading_deg);
   const auto pos_in_route = std::find_if(m.route.edges.begin(), m.route.edges.end(), [&](EdgeId e) {
     return std::any_of(points.begin(), points.end(), [&](const planner::EdgePoint& q) { return q.edge == e; });
   });

@@ -22,6 +22,7 @@
 #include "server/commit_queue.hpp"
 #include "server/dispatch_types.hpp"
 #include "server/store.hpp"
+#include "server/vehicle_tracker.hpp"
 
 namespace boost::asio {
 class thread_pool;
@@ -138,6 +139,8 @@ class DispatchService {
   Store* store_;
   std::unique_ptr<CommitQueue> commits_;  // null without a store
   maps::EdgeSnapper snapper_;
+  // Each vehicle's map matcher and last accepted fix; its locks are taken before, never under, ours.
+  VehicleTracker tracker_;
   const std::unordered_map<NodeId, maps::SignalPlan> plans_;
   std::unordered_multimap<std::int64_t, EdgeId> edges_by_way_;
 

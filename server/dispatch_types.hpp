@@ -87,8 +87,18 @@ struct VehicleView {
   std::optional<MissionId> mission;
 };
 
+// What the tracker made of a position report: followed, or stored only (stale, duplicate, outlier,
+// low_accuracy), and where the map matcher put it.
+struct PositionMatch {
+  std::string disposition = "followed";
+  std::optional<EdgeId> edge;  // matched edge, when followed and matched
+  double offset_m = 0;
+  double confidence = 0;  // the matcher's probability share for the chosen road point, 0..1
+};
+
 struct PositionResult {
   std::optional<MissionId> mission;  // the vehicle's active mission, if any
+  PositionMatch match;
   double snap_distance_m = 0;
   bool route_changed = false;
   bool completed = false;

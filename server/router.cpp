@@ -170,14 +170,30 @@ Router::Router(DispatchService& service, TokenAuth auth, RouterConfig config, Cl
           throw ApiError(403, "forbidden", "this token may report positions for vehicle '" + *who.vehicle_id + "' only");
         }
         const auto started = std::chrono::steady_clock::now();
-        const PositionResult res = service_.report_position(position_from_json(parse_body(r.body), vehicle), clock_());
+        const PositionReport raw = position_from_json(parse_body(r.body), vehicle);
+        const PositionResult res = service_.report_position(raw, clock_());
         metrics_.observe("position_replan_seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
         json out{{"accepted", true},
+                 {"followed", res.match.disposition == "followed"},
+                 {"disposition", res.match.disposition},
+                 {"raw", {{"lat", raw.position.lat_deg}, {"lon", raw.position.lon_deg}, {"timestamp", raw.timestamp_s},
+                          {"source", raw.source}}},
                  {"snap_distance_m", res.snap_distance_m},
                  {"route_changed", res.route_changed},
                  {"completed", res.completed}};
         out["mission"] = res.mission ? json(*res.mission) : json(nullptr);
         out["eta_s"] = res.mission && !res.completed ? json(res.eta_s) : json(nullptr);
+        if (res.match.edge) {
+          const EdgeId e = *res.match.edge;
+          out["edge"] = e.v;
+          out["osm_way_id"] = service_.graph().osm_way(e).v;
+          out["name"] = service_.graph().name(e);
+          out["offset_m"] = res.match.offset_m;
+          out["match_confidence"] = res.match.confidence;
+        } else {
+          out["edge"] = nullptr;
+          out["match_confidence"] = nullptr;
+        }
         HttpResponse response = json_response(200, out);
         response.after_commit = res.durable;
         return response;

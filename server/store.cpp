@@ -18,7 +18,7 @@ namespace corridor::server {
 namespace {
 
 // Each entry moves the schema one version up; never edit a released entry, append a new one.
-constexpr std::array<const char*, 2> kMigrations{
+constexpr std::array<const char*, 3> kMigrations{
     R"sql(
     CREATE TABLE missions (
       id INTEGER PRIMARY KEY AUTOINCREMENT,
@@ -75,6 +75,14 @@ constexpr std::array<const char*, 2> kMigrations{
       position_id INTEGER NOT NULL) WITHOUT ROWID;
     INSERT INTO vehicle_last_position(vehicle_id, position_id) SELECT vehicle_id, MAX(id) FROM positions GROUP BY vehicle_id;
     DROP INDEX positions_vehicle;
+    )sql",
+    // v3: what the vehicle tracker made of each report (followed, stale, duplicate, outlier,
+    // low_accuracy) and where the map matcher put it.
+    R"sql(
+    ALTER TABLE positions ADD COLUMN disposition TEXT NOT NULL DEFAULT 'followed';
+    ALTER TABLE positions ADD COLUMN edge INTEGER;
+    ALTER TABLE positions ADD COLUMN offset_m REAL;
+    ALTER TABLE positions ADD COLUMN match_confidence REAL;
     )sql",
 };
 
@@ -347,13 +355,18 @@ void Store::update_mission_state(MissionId id, MissionState state, double time_s
   s.bind(1, std::string(to_string(state))).bind(2, time_s).bind(3, static_cast<std::int64_t>(id)).step();
 }
 
-void Store::insert_position(const PositionReport& p, std::optional<MissionId> mission, double received_s) {
+void Store::insert_position(const PositionReport& p, std::optional<MissionId> mission, double received_s,
+                            const PositionMatch& match) {
   Statement s(cached("INSERT INTO positions(vehicle_id, mission_id, lat, lon, heading_deg, speed_mps, hdop, timestamp_s, "
-                     "source, received_s) VALUES (?,?,?,?,?,?,?,?,?,?)"));
+                     "source, received_s, disposition, edge, offset_m, match_confidence) VALUES (?,?,?,?,?,?,?,?,?,?,?,?,?,?)"));
   s.bind(1, p.vehicle_id);
   s.bind(2, mission ? std::optional<double>(static_cast<double>(*mission)) : std::nullopt);
   s.bind(3, p.position.lat_deg).bind(4, p.position.lon_deg).bind(5, p.heading_deg).bind(6, p.speed_mps).bind(7, p.hdop);
-  s.bind(8, p.timestamp_s).bind(9, p.source).bind(10, received_s).step();
+  s.bind(8, p.timestamp_s).bind(9, p.source).bind(10, received_s).bind(11, match.disposition);
+  s.bind(12, match.edge ? std::optional<double>(match.edge->v) : std::nullopt);
+  s.bind(13, match.edge ? std::optional<double>(match.offset_m) : std::nullopt);
+  s.bind(14, match.edge ? std::optional<double>(match.confidence) : std::nullopt).step();
+  if (match.disposition != "followed") return;
   Statement latest(cached("INSERT INTO vehicle_last_position(vehicle_id, position_id) VALUES (?, last_insert_rowid()) "
                           "ON CONFLICT(vehicle_id) DO UPDATE SET position_id = excluded.position_id"));
   latest.bind(1, p.vehicle_id).step();

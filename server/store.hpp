@@ -85,7 +85,10 @@ class Store {
   // Under the row's own id (the service numbers missions, so it knows the id before storing).
   void insert_mission(const MissionRow& row);
   void update_mission_state(MissionId id, MissionState state, double time_s);
-  void insert_position(const PositionReport& report, std::optional<MissionId> mission, double received_s);
+  // Stored as received, with what the tracker made of it; only a followed report becomes the
+  // vehicle's latest position.
+  void insert_position(const PositionReport& report, std::optional<MissionId> mission, double received_s,
+                       const PositionMatch& match = {});
   void insert_route_revision(MissionId mission, std::uint32_t revision, const std::string& reason, double eta_s,
                              double length_m, const std::string& geometry_json, double time_s);
   void insert_congestion(EdgeId edge, const planner::EdgeCondition& condition, std::optional<double> expires_at_s,

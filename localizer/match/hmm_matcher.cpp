@@ -32,8 +32,12 @@ void HmmConfig::validate() const {
   }
 }
 
-HmmMatcher::HmmMatcher(const maps::RoadGraph& graph, const maps::EdgeSnapper& snapper, HmmConfig config)
-    : graph_(graph), snapper_(snapper), config_(config), distances_(graph) {
+HmmMatcher::HmmMatcher(const maps::RoadGraph& graph, const maps::EdgeSnapper& snapper, HmmConfig config,
+                       SearchArrays arrays)
+    : graph_(graph),
+      snapper_(snapper),
+      config_(config),
+      distances_(arrays == SearchArrays::owned ? std::make_unique<planner::BoundedDistances>(graph.node_count()) : nullptr) {
   config_.validate();
 }
 
@@ -63,7 +67,7 @@ std::vector<HmmMatcher::Candidate> HmmMatcher::candidates_for(const GpsFix& fix,
   return out;
 }
 
-bool HmmMatcher::link(const Step& prev, Step& next, const GpsFix& fix) {
+bool HmmMatcher::link(const Step& prev, Step& next, const GpsFix& fix, planner::BoundedDistances& distances) {
   const double dt = next.time_s - prev.time_s;
   if (dt > config_.gap_s || dt < 0.0) return false;
   const double straight = maps::distance_m(prev.raw, next.raw);
@@ -95,10 +99,10 @@ bool HmmMatcher::link(const Step& prev, Step& next, const GpsFix& fix) {
         route = std::max(0.0, c.offset_m - p.offset_m);
       } else {
         if (!searched) {
-          distances_.run(graph_.head(p.edge), std::max(0.0, bound - to_end), targets);
+          distances.run(graph_, graph_.head(p.edge), std::max(0.0, bound - to_end), targets);
           searched = true;
         }
-        const double between = distances_.length_m(graph_.tail(c.edge));
+        const double between = distances.length_m(graph_.tail(c.edge));
         if (between == planner::kInfCost) continue;
         route = to_end + between + c.offset_m;
       }
@@ -156,10 +160,13 @@ MatchedPoint HmmMatcher::point_of(const Step& step, std::size_t index) const {
   return m;
 }
 
-MatchedPoint HmmMatcher::update(const GpsFix& fix) {
+MatchedPoint HmmMatcher::update(const GpsFix& fix, planner::BoundedDistances* lent) {
   if (!maps::is_valid_lat_lon(fix.position) || !std::isfinite(fix.time_s)) {
     throw std::invalid_argument("a fix needs a finite time and a valid coordinate");
   }
+  planner::BoundedDistances* distances = lent != nullptr ? lent : distances_.get();
+  if (distances == nullptr) throw std::logic_error("a matcher with lent search arrays was given none");
+  if (distances->node_count() != graph_.node_count()) throw std::logic_error("lent search arrays are for another graph");
   Step step;
   step.time_s = fix.time_s;
   step.raw = graph_.projection().to_local(fix.position);
@@ -170,7 +177,7 @@ MatchedPoint HmmMatcher::update(const GpsFix& fix) {
     none.distance_m = 0.0;
     return none;
   }
-  if (window_.empty() || !link(window_.back(), step, fix)) {
+  if (window_.empty() || !link(window_.back(), step, fix, *distances)) {
     // A new chain: its first step is scored by the emission alone.
     step = Step{fix.time_s, step.raw, candidates_for(fix, step.raw), true};
     window_.clear();
@@ -182,6 +189,9 @@ MatchedPoint HmmMatcher::update(const GpsFix& fix) {
 }
 
 std::vector<MatchedPoint> HmmMatcher::match(std::span<const GpsFix> trace) {
+  std::unique_ptr<planner::BoundedDistances> own;
+  if (!distances_) own = std::make_unique<planner::BoundedDistances>(graph_.node_count());
+  planner::BoundedDistances& distances = distances_ ? *distances_ : *own;
   for (std::size_t i = 0; i < trace.size(); ++i) {
     if (!maps::is_valid_lat_lon(trace[i].position) || !std::isfinite(trace[i].time_s)) {
       throw std::invalid_argument("fix " + std::to_string(i + 1) + " needs a finite time and a valid coordinate");
@@ -217,7 +227,7 @@ std::vector<MatchedPoint> HmmMatcher::match(std::span<const GpsFix> trace) {
       chain_first = steps.size();
       continue;  // out[i] stays unmatched
     }
-    const bool linked = steps.size() > chain_first && link(steps.back(), step, trace[i]);
+    const bool linked = steps.size() > chain_first && link(steps.back(), step, trace[i], distances);
     if (!linked) {
       finish_chain(chain_first);
       chain_first = steps.size();

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <deque>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -36,13 +37,20 @@ struct HmmConfig {
   void validate() const;
 };
 
+// Whether a matcher owns the arrays of its network-distance searches (one per node of the graph),
+// or borrows them for each call: a server tracking hundreds of vehicles lends one set per thread
+// instead of keeping a graph-sized set per vehicle.
+enum class SearchArrays { owned, lent };
+
 class HmmMatcher {
  public:
-  HmmMatcher(const maps::RoadGraph& graph, const maps::EdgeSnapper& snapper, HmmConfig config = {});
+  HmmMatcher(const maps::RoadGraph& graph, const maps::EdgeSnapper& snapper, HmmConfig config = {},
+             SearchArrays arrays = SearchArrays::owned);
 
   // Online: takes the next fix (time not before the last one's) and returns the best estimate of
-  // where the vehicle is now, given every fix so far in the chain.
-  MatchedPoint update(const GpsFix& fix);
+  // where the vehicle is now, given every fix so far in the chain. A matcher with lent arrays
+  // must be given them here; an owning one may be.
+  MatchedPoint update(const GpsFix& fix, planner::BoundedDistances* lent = nullptr);
   // Forgets the chain (a vehicle teleported, a new trace).
   void reset();
 
@@ -71,14 +79,14 @@ class HmmMatcher {
   // Candidates of a fix with their emission scores.
   std::vector<Candidate> candidates_for(const GpsFix& fix, maps::Point2 raw) const;
   // Links `next` to `prev` (scores and parents); false when no candidate can be reached.
-  bool link(const Step& prev, Step& next, const GpsFix& fix);
+  bool link(const Step& prev, Step& next, const GpsFix& fix, planner::BoundedDistances& distances);
   [[nodiscard]] MatchedPoint point_of(const Step& step, std::size_t index) const;
   [[nodiscard]] static std::size_t best(const Step& step);
 
   const maps::RoadGraph& graph_;
   const maps::EdgeSnapper& snapper_;
   HmmConfig config_;
-  planner::BoundedDistances distances_;
+  std::unique_ptr<planner::BoundedDistances> distances_;  // null when lent
   std::deque<Step> window_;
 };
 

@@ -95,7 +95,8 @@ api GET "/v1/missions/$mission" > /dev/null
 check "route revision advanced" "[[ \$(jq_py \"d['route_revision']\") -ge 2 ]]"
 
 # 4. Completion at the destination.
-status=$(api POST /v1/vehicles/amb-1/position '{"lat":43.7496,"lon":7.4365,"timestamp":20}')
+# (At t=200: sooner, the jump from the last fix would be faster than a vehicle drives, an outlier.)
+status=$(api POST /v1/vehicles/amb-1/position '{"lat":43.7496,"lon":7.4365,"timestamp":200}')
 check "mission completes at the destination" "[[ $status == 200 && \$(jq_py \"d['completed']\") == True ]]"
 api GET "/v1/missions/$mission" > /dev/null
 check "mission state completed" "[[ \$(jq_py \"d['state']\") == completed ]]"

@@ -133,6 +133,7 @@ TEST(DispatchService, PositionsAlongTheRouteCompleteTheMission) {
   PositionReport last;
   last.vehicle_id = "amb-2";
   last.position = corner(true);
+  last.timestamp_s = t + 10;  // an older report would be stale, and move nothing
   const PositionResult r = service.report_position(last, t + 10);
   EXPECT_TRUE(r.completed || completed);
   EXPECT_EQ(service.mission(m.id).state, MissionState::completed);
@@ -353,7 +354,7 @@ TEST(DispatchService, PersistsAndResumesActiveMissionsAfterRestart) {
     EXPECT_GT(store.count("preemption_events"), 0u);
   }  // the process "dies" here: nothing is flushed beyond what each call committed
   Store store(db.path());
-  EXPECT_EQ(store.schema_version(), 2);
+  EXPECT_EQ(store.schema_version(), 3);
   DispatchService service(grid(), {}, &store, 10.0);
   EXPECT_EQ(service.active_mission_count(), 1u);
   const MissionView resumed = service.mission(kept);
@@ -397,12 +398,14 @@ TEST(Store, MigratesVersion1PositionsToEachVehiclesLatest) {
   ASSERT_EQ(sqlite3_open(db.path().c_str(), &raw), SQLITE_OK);
   ASSERT_EQ(sqlite3_exec(raw,
                          "DROP TABLE vehicle_last_position; CREATE INDEX positions_vehicle ON positions(vehicle_id, id);"
-                         "DELETE FROM schema_migrations WHERE version = 2;",
+                         "ALTER TABLE positions DROP COLUMN disposition; ALTER TABLE positions DROP COLUMN edge;"
+                         "ALTER TABLE positions DROP COLUMN offset_m; ALTER TABLE positions DROP COLUMN match_confidence;"
+                         "DELETE FROM schema_migrations WHERE version >= 2;",
                          nullptr, nullptr, nullptr),
             SQLITE_OK);
   sqlite3_close(raw);
   Store store(db.path());
-  EXPECT_EQ(store.schema_version(), 2);
+  EXPECT_EQ(store.schema_version(), 3);
   const auto a = store.last_position("amb-a");
   ASSERT_TRUE(a.has_value());
   EXPECT_DOUBLE_EQ(a->position.lat_deg, 43.732);
@@ -423,7 +426,7 @@ TEST(Store, RefusesADatabaseFromANewerBuild) {
   { Store store(db.path()); }
   {
     Store store(db.path());  // reopening an up-to-date database is fine
-    EXPECT_EQ(store.schema_version(), 2);
+    EXPECT_EQ(store.schema_version(), 3);
   }
   sqlite3* raw = nullptr;
   ASSERT_EQ(sqlite3_open(db.path().c_str(), &raw), SQLITE_OK);
