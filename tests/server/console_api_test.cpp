@@ -183,6 +183,22 @@ TEST(ConsoleApi, VehiclesRouteHistoryAndEventPayloads) {
   EXPECT_EQ(pj["vehicle_id"], "amb-1");
 }
 
+TEST(PositionApi, AnswersWhatTheTrackerMadeOfTheReport) {
+  Rig rig;
+  const auto p = grid().projection().to_lat_lon(grid().point_along(EdgeId{5}, 20.0));
+  const std::string body = "{\"lat\":" + std::to_string(p.lat_deg) + ",\"lon\":" + std::to_string(p.lon_deg) + ",\"timestamp\":7}";
+  const json first = json::parse(rig.call("POST", "/v1/vehicles/amb-9/position", kDispatcher, body).body);
+  EXPECT_EQ(first["disposition"], "followed");
+  EXPECT_EQ(first["followed"], true);
+  EXPECT_TRUE(first["edge"] == 5 || first["edge"] == grid().twin(EdgeId{5}).v) << first.dump();
+  EXPECT_GT(first["match_confidence"].get<double>(), 0.0);
+  EXPECT_NEAR(first["raw"]["lat"].get<double>(), p.lat_deg, 1e-6);
+  const json again = json::parse(rig.call("POST", "/v1/vehicles/amb-9/position", kDispatcher, body).body);
+  EXPECT_EQ(again["disposition"], "duplicate");
+  EXPECT_EQ(again["followed"], false);
+  EXPECT_TRUE(again["edge"].is_null());
+}
+
 TEST(ConsoleApi, SignalStateFollowsItsPreemption) {
   Rig rig;
   const json signals = body(rig.call("GET", "/v1/signals", kViewer))["signals"];
