@@ -3,6 +3,7 @@
 #include <chrono>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <memory>
 
 #include <nlohmann/json.hpp>
@@ -12,6 +13,7 @@
 #include "localizer/match/hmm_matcher.hpp"
 #include "localizer/match/synthetic_trace.hpp"
 #include "localizer/match/trace_io.hpp"
+#include "localizer/study/localization_study.hpp"
 #include "planner/route.hpp"
 
 namespace corridor::app {
@@ -131,6 +133,12 @@ void run_match(const MatchOptions& o) {
 
 struct MatchBenchOptions {
   MapOptions map;
+  std::vector<std::string> fcd;
+  std::string prefix;
+  double outage_s = 60.0;
+  std::string plot;
+  std::string plot_id;
+  std::string csv;
   int drives = 20;
   std::size_t edges = 60;
   double noise_m = 5.0;
@@ -138,7 +146,86 @@ struct MatchBenchOptions {
   std::uint64_t seed = 1;
 };
 
+json drive_json(const localizer::DriveResult& d) {
+  auto ratio = [](double a, double b) { return b > 0.0 ? a / b : 0.0; };
+  auto rmse = [](double sq, std::size_t n) { return n > 0 ? std::sqrt(sq / static_cast<double>(n)) : 0.0; };
+  const double truth = static_cast<double>(d.with_truth);
+  return {{"id", d.id},
+          {"samples", d.samples},
+          {"length_m", std::round(d.length_m)},
+          {"rmse_raw_m", rmse(d.sq_raw, d.n_raw)},
+          {"rmse_nearest_m", rmse(d.sq_nearest, d.n_raw)},
+          {"rmse_hmm_m", rmse(d.sq_hmm, d.n_hmm)},
+          {"rmse_fused_m", rmse(d.sq_fused, d.n_fused)},
+          {"correct_edge_hmm_by_time", ratio(static_cast<double>(d.correct_hmm), truth)},
+          {"correct_edge_hmm_by_length", ratio(d.length_correct_hmm, d.length_with_truth)},
+          {"correct_road_hmm", ratio(static_cast<double>(d.correct_hmm_road), truth)},
+          {"correct_road_nearest", ratio(static_cast<double>(d.correct_nearest_road), truth)},
+          {"correct_edge_fused_by_time", ratio(static_cast<double>(d.correct_fused), truth)},
+          {"outage_samples", d.outage_samples},
+          {"outage_correct_edge_share", ratio(static_cast<double>(d.outage_correct), static_cast<double>(d.outage_samples))},
+          {"outage_rmse_m", rmse(d.outage_sq, d.outage_samples)},
+          {"recovery_s", d.recovery_s},
+          {"handback_jump_m", d.handback_jump_m}};
+}
+
+void run_fcd_study(const MatchBenchOptions& o) {
+  if (!(o.noise_m >= 0.0) || !(o.outliers >= 0.0 && o.outliers <= 1.0) || !(o.outage_s >= 0.0)) {
+    throw UsageError("--noise-m and --outage-s must be >= 0 and --outliers within [0, 1]");
+  }
+  const maps::RoadGraph graph = load_map_from_options(o.map);
+  const maps::EdgeSnapper snapper(graph);
+  std::map<std::string, std::vector<localizer::TruthSample>> drives;
+  for (const std::string& file : o.fcd) {
+    for (auto& [id, samples] : localizer::read_fcd(file, o.prefix)) drives[file + ":" + id] = std::move(samples);
+  }
+  if (drives.empty()) throw UsageError("no vehicle in the fcd file(s) matches --prefix '" + o.prefix + "'");
+  localizer::StudyConfig config;
+  config.noise_sigma_m = o.noise_m;
+  config.outlier_share = o.outliers;
+  config.outage_s = o.outage_s;
+  config.seed = o.seed;
+  localizer::DrivePlot plot;
+  const std::string plot_id = o.plot_id.empty() ? drives.begin()->first : o.plot_id;
+  const auto started = std::chrono::steady_clock::now();
+  const auto result = localizer::run_localization_study(graph, snapper, drives, config, plot_id, o.plot.empty() ? nullptr : &plot);
+  const double took_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  json list = json::array();
+  for (const auto& d : result.drives) list.push_back(drive_json(d));
+  if (!o.csv.empty()) {
+    std::ofstream csv(o.csv);
+    if (!csv) throw UsageError("cannot write --csv '" + o.csv + "'");
+    bool header = true;
+    for (const auto& d : list) {
+      if (header) {
+        bool first = true;
+        for (const auto& [k, v] : d.items()) csv << (first ? "" : ",") << k, first = false;
+        csv << '\n';
+        header = false;
+      }
+      bool first = true;
+      for (const auto& [k, v] : d.items()) csv << (first ? "" : ",") << (v.is_string() ? v.get<std::string>() : v.dump()), first = false;
+      csv << '\n';
+    }
+  }
+  if (!o.plot.empty()) {
+    std::ofstream svg(o.plot);
+    if (!svg) throw UsageError("cannot write --plot '" + o.plot + "'");
+    svg << localizer::drive_plot_svg(graph, plot, plot_id);
+  }
+  json out{{"map", o.map.map_file.empty() ? "embedded" : o.map.map_file},
+           {"drives", result.drives.size()},
+           {"noise_sigma_m", o.noise_m},
+           {"outlier_share", o.outliers},
+           {"outage_s", o.outage_s},
+           {"total", drive_json(result.total)},
+           {"per_drive", std::move(list)},
+           {"seconds", took_s}};
+  std::cout << out.dump(2) << '\n';
+}
+
 void run_match_bench(const MatchBenchOptions& o) {
+  if (!o.fcd.empty()) return run_fcd_study(o);
   if (o.drives < 1 || o.edges < 2) throw UsageError("--drives must be at least 1 and --edges at least 2");
   if (!(o.noise_m >= 0.0) || !(o.outliers >= 0.0 && o.outliers <= 1.0)) {
     throw UsageError("--noise-m must be >= 0 and --outliers within [0, 1]");
@@ -222,6 +309,12 @@ void register_match_bench(CLI::App& bench) {
   cmd->add_option("--noise-m", o->noise_m, "GPS noise σ in metres")->capture_default_str();
   cmd->add_option("--outliers", o->outliers, "share of multipath outliers (60 m off)")->capture_default_str();
   cmd->add_option("--seed", o->seed, "first drive's seed")->capture_default_str();
+  cmd->add_option("--fcd", o->fcd, "SUMO fcd output (geo) as ground truth: the accuracy study instead of random walks");
+  cmd->add_option("--prefix", o->prefix, "with --fcd: only vehicles whose id starts with this");
+  cmd->add_option("--outage-s", o->outage_s, "with --fcd: one GPS outage of this length per drive")->capture_default_str();
+  cmd->add_option("--plot", o->plot, "with --fcd: an SVG of one drive");
+  cmd->add_option("--plot-id", o->plot_id, "with --fcd: the drive to plot (FILE:VEHICLE; default the first)");
+  cmd->add_option("--csv", o->csv, "with --fcd: per-drive figures as CSV");
   cmd->callback([o] { run_match_bench(*o); });
 }
 

@@ -1,0 +1,56 @@
+// The localizer's one entry point per sensor: GPS fixes and odometry increments in, positions on
+// the road graph out. As in the seed, GPS is followed while its HDOP is at most 10, through the
+// online HMM matcher; when the HDOP is worse or fixes stop coming, odometry takes over from the
+// last good matched fix and heading and is kept on the map (OdometryMapMatcher). Handing over to
+// odometry continues from the last GPS point, so the position does not jump; handing back to GPS
+// moves it by the drift the odometry accumulated, which the output's sigma_m said to expect.
+#pragma once
+
+#include "localizer/fusion/odometry_map_matcher.hpp"
+#include "localizer/match/hmm_matcher.hpp"
+
+namespace corridor::localizer {
+
+struct LocalizerConfig {
+  HmmConfig hmm;
+  OdometryMatchConfig odometry;
+  double max_gps_hdop = 10.0;   // the seed's switch
+  double gps_timeout_s = 2.5;   // no good fix for this long: odometry
+};
+
+enum class PositionSource { none, gps, odometry };
+const char* to_string(PositionSource s);
+
+struct LocalizedPoint {
+  PositionSource source = PositionSource::none;
+  MatchedPoint match;       // edge, offset and point on the road
+  maps::LatLon position;    // of match.point
+  double heading_deg = 0;   // of the road there, in the direction of travel
+  double speed_mps = 0;
+  double sigma_m = 0;       // 1σ accuracy
+};
+
+class GpsOdometryLocalizer {
+ public:
+  GpsOdometryLocalizer(const maps::RoadGraph& graph, const maps::EdgeSnapper& snapper, LocalizerConfig config = {});
+
+  // A GPS fix: followed if its HDOP is at most the limit (none stated counts as good).
+  LocalizedPoint on_gps(const GpsFix& fix);
+  // An odometry increment: moves the vehicle only while GPS is poor or absent.
+  LocalizedPoint on_odometry(const OdometryStep& step);
+
+  [[nodiscard]] const LocalizedPoint& last() const { return last_; }
+
+ private:
+  LocalizedPoint output(PositionSource source, const MatchedPoint& m, double sigma_m);
+  [[nodiscard]] double road_heading_deg(EdgeId e, double offset_m) const;
+
+  const maps::RoadGraph& graph_;
+  LocalizerConfig config_;
+  HmmMatcher hmm_;
+  OdometryMapMatcher odometry_;
+  double last_good_gps_s_ = -1e18;
+  LocalizedPoint last_;
+};
+
+}  // namespace corridor::localizer

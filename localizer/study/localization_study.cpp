@@ -1,0 +1,237 @@
+#include "localizer/study/localization_study.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <sstream>
+
+namespace corridor::localizer {
+namespace {
+
+double wrap180(double d) {
+  d = std::fmod(d, 360.0);
+  if (d <= -180.0) d += 360.0;
+  if (d > 180.0) d -= 360.0;
+  return d;
+}
+
+double bearing_deg(const maps::RoadGraph& g, EdgeId e, double offset_m) {
+  const double len = g.length_m(e);
+  const maps::Point2 a = g.point_along(e, std::clamp(offset_m - 3.0, 0.0, len));
+  const maps::Point2 b = g.point_along(e, std::clamp(offset_m + 3.0, 0.0, len));
+  return std::atan2(b.x_m - a.x_m, b.y_m - a.y_m) * 180.0 / std::numbers::pi;
+}
+
+// The edge the vehicle truly drives: the nearest road point within the radius whose direction
+// agrees with the vehicle's heading.
+EdgeId true_edge(const maps::RoadGraph& g, const maps::EdgeSnapper& snapper, maps::Point2 p, double heading_deg,
+                 double radius_m) {
+  EdgeId best;
+  double best_d = 1e18;
+  for (const maps::SnapResult& r : snapper.candidates_local(p, radius_m, 8)) {
+    for (auto [e, off] : {std::pair{r.edge, r.offset_m}, std::pair{r.twin, r.twin_offset_m}}) {
+      if (!e.valid()) continue;
+      if (std::abs(wrap180(bearing_deg(g, e, off) - heading_deg)) > 60.0) continue;
+      if (r.distance_m < best_d) best = e, best_d = r.distance_m;
+    }
+  }
+  return best;
+}
+
+bool same_road(const maps::RoadGraph& g, EdgeId a, EdgeId b) { return a == b || (a.valid() && g.twin(a) == b); }
+
+}  // namespace
+
+StudyResult run_localization_study(const maps::RoadGraph& g, const maps::EdgeSnapper& snapper,
+                                   const std::map<std::string, std::vector<TruthSample>>& drives, const StudyConfig& config,
+                                   const std::string& plot_id, DrivePlot* plot) {
+  StudyResult out;
+  out.total.id = "all";
+  std::uint64_t drive_seed = config.seed;
+  for (const auto& [id, samples] : drives) {
+    if (samples.size() < 10) continue;
+    std::mt19937_64 rng(drive_seed++);
+    std::normal_distribution<double> gauss(0.0, 1.0);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    DriveResult d;
+    d.id = id;
+    d.samples = samples.size();
+    const double t0 = samples.front().time_s, t1 = samples.back().time_s;
+    const double outage_begin = t0 + config.outage_at * (t1 - t0);
+    const double outage_end = config.outage_s > 0.0 ? outage_begin + config.outage_s : outage_begin;
+    const double scale_error = config.odometry_scale_sigma * gauss(rng);
+
+    // Truth in the local frame, the GPS trace (outage dropped), and the odometry increments.
+    std::vector<maps::Point2> truth(samples.size());
+    std::vector<GpsFix> gps;
+    std::vector<std::size_t> gps_sample;
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+      truth[i] = g.projection().to_local(samples[i].position);
+      const double t = samples[i].time_s;
+      if (t >= outage_begin && t < outage_end) continue;
+      maps::Point2 q{truth[i].x_m + config.noise_sigma_m * gauss(rng), truth[i].y_m + config.noise_sigma_m * gauss(rng)};
+      if (unit(rng) < config.outlier_share) {
+        const double a = unit(rng) * 2.0 * std::numbers::pi, r = 40.0 + 60.0 * unit(rng);
+        q = {q.x_m + r * std::cos(a), q.y_m + r * std::sin(a)};
+      }
+      GpsFix f;
+      f.time_s = t;
+      f.position = g.projection().to_lat_lon(q);
+      f.hdop = config.noise_sigma_m / config.localizer.hmm.sigma_base_m;
+      // A receiver's course over ground is noisy at low speed; give it only when moving.
+      if (samples[i].speed_mps > 3.0) f.heading_deg = std::fmod(samples[i].heading_deg + 5.0 * gauss(rng) + 360.0, 360.0);
+      f.speed_mps = std::max(0.0, samples[i].speed_mps + 0.3 * gauss(rng));
+      gps.push_back(f);
+      gps_sample.push_back(i);
+    }
+
+    // HMM over the GPS alone (batch), and the nearest road.
+    HmmMatcher batch(g, snapper, config.localizer.hmm);
+    const std::vector<MatchedPoint> hmm = batch.match(gps);
+    std::vector<MatchedPoint> hmm_at(samples.size());
+    for (std::size_t k = 0; k < gps.size(); ++k) hmm_at[gps_sample[k]] = hmm[k];
+
+    // The fusion, online, fed in time order: odometry each step, then the fix if there is one.
+    GpsOdometryLocalizer fusion(g, snapper, config.localizer);
+    std::vector<LocalizedPoint> fused(samples.size());
+    std::size_t next_fix = 0;
+    bool was_out = false;
+    maps::Point2 before_handback{};
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+      if (i > 0) {
+        const double dist = maps::distance_m(truth[i - 1], truth[i]) * (1.0 + scale_error);
+        const double turn = wrap180(samples[i].heading_deg - samples[i - 1].heading_deg) +
+                            config.odometry_heading_deg_per_100m * dist / 100.0 * gauss(rng);
+        fusion.on_odometry({samples[i].time_s, dist, turn});
+      }
+      const bool out_now = samples[i].time_s >= outage_begin && samples[i].time_s < outage_end;
+      if (was_out && !out_now) before_handback = fusion.last().match.point;
+      if (next_fix < gps.size() && gps_sample[next_fix] == i) fusion.on_gps(gps[next_fix++]);
+      fused[i] = fusion.last();
+      if (was_out && !out_now && fused[i].match.matched) d.handback_jump_m = maps::distance_m(before_handback, fused[i].match.point);
+      was_out = out_now;
+    }
+
+    // Scores.
+    std::vector<std::uint8_t> on_track(samples.size(), 0);
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+      const double step_m = i > 0 ? maps::distance_m(truth[i - 1], truth[i]) : 0.0;
+      d.length_m += step_m;
+      const bool out_now = samples[i].time_s >= outage_begin && samples[i].time_s < outage_end;
+      const EdgeId truth_edge = true_edge(g, snapper, truth[i], samples[i].heading_deg, config.truth_radius_m);
+      if (!out_now) {
+        const maps::Point2 raw = g.projection().to_local(gps[std::lower_bound(gps_sample.begin(), gps_sample.end(), i) - gps_sample.begin()].position);
+        d.sq_raw += std::pow(maps::distance_m(raw, truth[i]), 2);
+        ++d.n_raw;
+        const maps::SnapResult near = snapper.snap_local(raw, {500.0});
+        d.sq_nearest += std::pow(maps::distance_m(near.point, truth[i]), 2);
+        if (hmm_at[i].matched) {
+          d.sq_hmm += std::pow(maps::distance_m(hmm_at[i].point, truth[i]), 2);
+          ++d.n_hmm;
+        }
+        if (truth_edge.valid()) {
+          ++d.with_truth;
+          d.length_with_truth += step_m;
+          d.correct_nearest_road += same_road(g, near.edge, truth_edge) ? 1 : 0;
+          if (hmm_at[i].matched && hmm_at[i].edge == truth_edge) {
+            ++d.correct_hmm;
+            d.length_correct_hmm += step_m;
+          }
+          d.correct_hmm_road += hmm_at[i].matched && same_road(g, hmm_at[i].edge, truth_edge) ? 1 : 0;
+        }
+      }
+      if (fused[i].match.matched) {
+        d.sq_fused += std::pow(maps::distance_m(fused[i].match.point, truth[i]), 2);
+        ++d.n_fused;
+      }
+      const bool fused_correct = fused[i].match.matched && truth_edge.valid() && fused[i].match.edge == truth_edge;
+      if (truth_edge.valid() && !out_now) d.correct_fused += fused_correct ? 1 : 0;
+      if (out_now && truth_edge.valid()) {
+        ++d.outage_samples;
+        d.outage_correct += fused_correct ? 1 : 0;
+        if (fused[i].match.matched) d.outage_sq += std::pow(maps::distance_m(fused[i].match.point, truth[i]), 2);
+      }
+      on_track[i] = fused_correct && maps::distance_m(fused[i].match.point, truth[i]) < 15.0 ? 1 : 0;
+    }
+    // Recovery: from the outage's end until the fusion is back on the true edge, near the truth.
+    if (config.outage_s > 0.0) {
+      for (std::size_t i = 0; i < samples.size(); ++i) {
+        if (samples[i].time_s < outage_end) continue;
+        if (on_track[i] != 0) break;
+        d.recovery_s = samples[i].time_s - outage_end + 1.0;
+      }
+    }
+    if (plot != nullptr && id == plot_id) {
+      for (std::size_t i = 0; i < samples.size(); ++i) {
+        plot->truth.push_back(truth[i]);
+        plot->fused.push_back(fused[i].match.matched ? fused[i].match.point : truth[i]);
+        plot->hmm.push_back(hmm_at[i].matched ? hmm_at[i].point : maps::Point2{NAN, NAN});
+        plot->in_outage.push_back(samples[i].time_s >= outage_begin && samples[i].time_s < outage_end ? 1 : 0);
+      }
+      for (const GpsFix& f : gps) plot->gps.push_back(g.projection().to_local(f.position));
+    }
+    out.drives.push_back(d);
+    DriveResult& t = out.total;
+    t.samples += d.samples;
+    t.length_m += d.length_m;
+    t.sq_raw += d.sq_raw, t.sq_nearest += d.sq_nearest, t.sq_hmm += d.sq_hmm, t.sq_fused += d.sq_fused;
+    t.n_raw += d.n_raw, t.n_hmm += d.n_hmm, t.n_fused += d.n_fused;
+    t.with_truth += d.with_truth;
+    t.correct_nearest_road += d.correct_nearest_road, t.correct_hmm += d.correct_hmm;
+    t.correct_hmm_road += d.correct_hmm_road, t.correct_fused += d.correct_fused;
+    t.length_with_truth += d.length_with_truth, t.length_correct_hmm += d.length_correct_hmm;
+    t.outage_samples += d.outage_samples, t.outage_correct += d.outage_correct, t.outage_sq += d.outage_sq;
+    t.recovery_s = std::max(t.recovery_s, d.recovery_s);
+    t.handback_jump_m = std::max(t.handback_jump_m, d.handback_jump_m);
+  }
+  return out;
+}
+
+std::string drive_plot_svg(const maps::RoadGraph& g, const DrivePlot& plot, const std::string& title) {
+  double x0 = 1e18, y0 = 1e18, x1 = -1e18, y1 = -1e18;
+  for (const auto& p : plot.truth) {
+    x0 = std::min(x0, p.x_m), y0 = std::min(y0, p.y_m), x1 = std::max(x1, p.x_m), y1 = std::max(y1, p.y_m);
+  }
+  x0 -= 60, y0 -= 60, x1 += 60, y1 += 60;
+  const double w = 900.0, scale = w / std::max(1.0, x1 - x0), h = (y1 - y0) * scale;
+  auto X = [&](double x) { return (x - x0) * scale; };
+  auto Y = [&](double y) { return (y1 - y) * scale; };
+  std::ostringstream s;
+  s.precision(1);
+  s << std::fixed << "<svg xmlns='http://www.w3.org/2000/svg' width='" << w << "' height='" << h + 40
+    << "' font-family='sans-serif' font-size='13'>\n<rect width='100%' height='100%' fill='white'/>\n";
+  s << "<g stroke='#ccc' stroke-width='2' fill='none'>\n";
+  for (EdgeId e : g.edges()) {
+    if (g.twin(e).valid() && g.twin(e) < e) continue;
+    const auto pts = g.geometry(e);
+    bool near = false;
+    for (const auto& p : pts) near = near || (p.x_m > x0 && p.x_m < x1 && p.y_m > y0 && p.y_m < y1);
+    if (!near) continue;
+    s << "<polyline points='";
+    for (const auto& p : pts) s << X(p.x_m) << ',' << Y(p.y_m) << ' ';
+    s << "'/>\n";
+  }
+  s << "</g>\n";
+  auto line = [&](const std::vector<maps::Point2>& pts, const char* colour, double width, const char* dash) {
+    s << "<polyline fill='none' stroke='" << colour << "' stroke-width='" << width << "' stroke-dasharray='" << dash << "' points='";
+    for (const auto& p : pts) {
+      if (std::isfinite(p.x_m)) s << X(p.x_m) << ',' << Y(p.y_m) << ' ';
+    }
+    s << "'/>\n";
+  };
+  for (const auto& p : plot.gps) s << "<circle cx='" << X(p.x_m) << "' cy='" << Y(p.y_m) << "' r='2' fill='#e8a33d'/>\n";
+  line(plot.truth, "#222", 2.0, "none");
+  line(plot.hmm, "#2b7bd6", 2.0, "6 3");
+  std::vector<maps::Point2> outage;
+  for (std::size_t i = 0; i < plot.fused.size(); ++i) {
+    if (plot.in_outage[i] != 0) outage.push_back(plot.fused[i]);
+  }
+  line(outage, "#d62b4c", 3.0, "none");
+  s << "<text x='10' y='" << h + 18 << "'>" << title
+    << ": truth (black), raw GPS (orange dots), HMM matched (blue, dashed), odometry on the map through the outage (red)</text>\n";
+  s << "</svg>\n";
+  return s.str();
+}
+
+}  // namespace corridor::localizer

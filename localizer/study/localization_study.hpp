@@ -1,0 +1,66 @@
+// The localization accuracy study: SUMO's own trajectories (fcd) as ground truth, turned into
+// noisy GPS with multipath outliers and an outage, and into odometry with the drift we measured on
+// our stereo VO; then matched three ways (nearest road, HMM over GPS alone, GPS/odometry fusion)
+// and scored against the truth: RMSE, correct edge by time and by length, and how the fusion holds
+// the road through the outage and recovers after it.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "localizer/fusion/gps_odometry_localizer.hpp"
+#include "localizer/match/fcd_trace.hpp"
+
+namespace corridor::localizer {
+
+struct StudyConfig {
+  double noise_sigma_m = 8.0;       // GPS noise, per axis
+  double outlier_share = 0.02;      // multipath: fixes thrown 40–100 m
+  double outage_s = 60.0;           // one GPS outage per drive (0: none)...
+  double outage_at = 0.4;           // ...starting this far into the drive
+  double odometry_scale_sigma = 0.0062;   // VO translation error, per drive (0.62 %, docs/experiments/vo.md)
+  double odometry_heading_deg_per_100m = 0.24;  // VO rotation error
+  double truth_radius_m = 20.0;     // the true edge is searched this close to the true position
+  std::uint64_t seed = 1;
+  LocalizerConfig localizer;
+};
+
+struct DriveResult {
+  std::string id;
+  std::size_t samples = 0;
+  double length_m = 0;
+  // Squared-error sums and counts, so drives add up.
+  double sq_raw = 0, sq_nearest = 0, sq_hmm = 0, sq_fused = 0;
+  std::size_t n_raw = 0, n_hmm = 0, n_fused = 0;
+  std::size_t with_truth = 0;
+  std::size_t correct_nearest_road = 0, correct_hmm = 0, correct_hmm_road = 0, correct_fused = 0;
+  double length_with_truth = 0, length_correct_hmm = 0;
+  // The outage.
+  std::size_t outage_samples = 0, outage_correct = 0;
+  double outage_sq = 0;
+  double recovery_s = 0;    // after the outage: until the fused estimate is on the true edge again
+  double handback_jump_m = 0;  // how far the position moved when GPS came back
+};
+
+struct StudyResult {
+  std::vector<DriveResult> drives;
+  DriveResult total;  // sums over every drive (id "all")
+};
+
+// Every vehicle's trajectory is one drive. `trace_of` (optional) receives, for one vehicle id,
+// the per-sample truth, raw GPS, HMM and fused points (local frame) for a plot.
+struct DrivePlot {
+  std::vector<maps::Point2> truth, gps, hmm, fused;
+  std::vector<std::uint8_t> in_outage;
+};
+StudyResult run_localization_study(const maps::RoadGraph& graph, const maps::EdgeSnapper& snapper,
+                                   const std::map<std::string, std::vector<TruthSample>>& drives, const StudyConfig& config,
+                                   const std::string& plot_id = "", DrivePlot* plot = nullptr);
+
+// An SVG of one drive: truth, raw GPS dots, HMM-matched and fused tracks, the outage highlighted,
+// over the roads near it.
+std::string drive_plot_svg(const maps::RoadGraph& graph, const DrivePlot& plot, const std::string& title);
+
+}  // namespace corridor::localizer
