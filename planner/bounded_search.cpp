@@ -7,7 +7,20 @@
 namespace corridor::planner {
 
 BoundedDistances::BoundedDistances(std::size_t node_count)
-    : dist_(node_count, kInfCost), stamp_(node_count, 0), settled_(node_count, 0) {}
+    : dist_(node_count, kInfCost), stamp_(node_count, 0), settled_(node_count, 0), parent_edge_(node_count) {}
+
+std::vector<EdgeId> BoundedDistances::path_to(const maps::RoadGraph& graph, NodeId v) const {
+  std::vector<EdgeId> path;
+  if (settled_[v.index()] != round_) return path;
+  for (NodeId at = v; parent_edge_[at.index()].valid();) {
+    const EdgeId e = parent_edge_[at.index()];
+    path.push_back(e);
+    at = graph.tail(e);
+    if (path.size() > dist_.size()) break;  // cannot happen on a consistent run; never loop
+  }
+  std::reverse(path.begin(), path.end());
+  return path;
+}
 
 std::size_t BoundedDistances::run(const maps::RoadGraph& graph_, NodeId source, double max_length_m,
                                   std::span<const NodeId> targets) {
@@ -22,6 +35,7 @@ std::size_t BoundedDistances::run(const maps::RoadGraph& graph_, NodeId source, 
   heap_.clear();
   dist_[source.index()] = 0.0;
   stamp_[source.index()] = round_;
+  parent_edge_[source.index()] = EdgeId{};
   heap_.emplace_back(0.0, source.v);
   std::size_t settled = 0;
   const auto later = std::greater<>{};
@@ -44,6 +58,7 @@ std::size_t BoundedDistances::run(const maps::RoadGraph& graph_, NodeId source, 
       if (stamp_[v] != round_ || nd < dist_[v]) {
         stamp_[v] = round_;
         dist_[v] = nd;
+        parent_edge_[v] = e;
         heap_.emplace_back(nd, v);
         std::push_heap(heap_.begin(), heap_.end(), later);
       }

@@ -22,6 +22,9 @@ class BoundedDistances {
   // node in `targets` is settled. Returns the number of nodes settled.
   std::size_t run(const maps::RoadGraph& graph, NodeId source, double max_length_m, std::span<const NodeId> targets = {});
   [[nodiscard]] std::size_t node_count() const { return dist_.size(); }
+  // After run(): the edges of a shortest path from the source to v (empty for the source itself or
+  // a node the run did not settle).
+  [[nodiscard]] std::vector<EdgeId> path_to(const maps::RoadGraph& graph, NodeId v) const;
 
   // After run(): the shortest length to v if the run settled it (every target within the bound
   // is), else kInfCost.
@@ -33,6 +36,7 @@ class BoundedDistances {
   std::vector<double> dist_;
   std::vector<std::uint32_t> stamp_;    // dist_ is valid where stamp_ == round_
   std::vector<std::uint32_t> settled_;  // settled in the round stored here
+  std::vector<EdgeId> parent_edge_;     // the edge a node was reached by, valid where stamped
   std::vector<std::pair<double, std::uint32_t>> heap_;
   std::uint32_t round_ = 0;
 };

@@ -80,6 +80,10 @@ bool HmmMatcher::link(const Step& prev, Step& next, const GpsFix& fix, planner::
   std::sort(targets.begin(), targets.end());
   targets.erase(std::unique(targets.begin(), targets.end()), targets.end());
   const bool use_speed = fix.speed_mps && std::isfinite(*fix.speed_mps) && dt > 0.0;
+  // Both distances come from noisy fixes (projected onto the road, or straight between them), so
+  // their difference spreads with the GPS noise: the scale grows with σ, never below beta_m.
+  const double hdop = fix.hdop && std::isfinite(*fix.hdop) && *fix.hdop > 0.0 ? *fix.hdop : config_.default_hdop;
+  const double beta = std::max(config_.beta_m, config_.beta_per_sigma * hdop * config_.sigma_base_m);
 
   for (Candidate& c : next.candidates) {
     c.parent = -1;
@@ -108,8 +112,8 @@ bool HmmMatcher::link(const Step& prev, Step& next, const GpsFix& fix, planner::
       }
       if (route > bound || (dt > 0.0 && route / dt > config_.max_speed_mps)) continue;
       // Newson & Krumm's transition: exponential in |route − straight line|.
-      double transition = -std::abs(route - straight) / config_.beta_m;
-      if (use_speed) transition -= std::abs(route - *fix.speed_mps * dt) / (2.0 * config_.beta_m);
+      double transition = -std::abs(route - straight) / beta;
+      if (use_speed) transition -= std::abs(route - *fix.speed_mps * dt) / (2.0 * beta);
       const double score = p.score + transition;
       if (score > best[j]) {
         best[j] = score;
@@ -214,6 +218,22 @@ std::vector<MatchedPoint> HmmMatcher::match(std::span<const GpsFix> trace) {
       at = steps[k].candidates[static_cast<std::size_t>(at)].parent;
       --k;
       if (at < 0) break;  // cannot happen inside a chain; stop rather than misread
+    }
+    if (config_.along_path != HmmConfig::AlongPath::smoothed) return;
+    std::vector<GpsFix> chain_fixes;
+    std::vector<MatchedPoint> chain_points;
+    for (std::size_t j = first; j < steps.size(); ++j) {
+      chain_fixes.push_back(trace[fix_of[j]]);
+      chain_points.push_back(out[fix_of[j]]);
+    }
+    SmootherConfig smoother;
+    smoother.sigma_base_m = config_.sigma_base_m;
+    smoother.default_hdop = config_.default_hdop;
+    const auto smoothed = smooth_along_path(graph_, distances, chain_fixes, chain_points, smoother);
+    for (std::size_t j = first; j < steps.size(); ++j) {
+      MatchedPoint& m = out[fix_of[j]];
+      m = smoothed[j - first];
+      m.distance_m = maps::distance_m(steps[j].raw, m.point);
     }
   };
   std::size_t chain_first = 0;

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "localizer/match/gps_fix.hpp"
+#include "localizer/match/path_smoother.hpp"
 #include "maps/edge_snapper.hpp"
 #include "planner/bounded_search.hpp"
 
@@ -25,13 +26,17 @@ struct HmmConfig {
   double radius_sigmas = 4.0;
   double max_radius_m = 200.0;
   std::size_t max_candidates = 6;  // roads per fix (each two-way road gives two directed points)
-  double beta_m = 6.0;            // transition scale for |network − straight-line| (metres)
+  double beta_m = 6.0;            // transition scale for |network − straight-line| (metres)...
+  double beta_per_sigma = 0.7;    // ...at least this × the fix's σ
   double max_speed_mps = 70.0;    // a move needing more is impossible
   double gap_s = 60.0;            // fixes further apart in time break the chain
   double heading_sigma_deg = 40.0;
   double heading_min_speed_mps = 2.0;  // below this the course over ground is noise
   double backward_tolerance_m = 8.0;   // noise may put a fix a little behind the last one on a road
   std::size_t window = 8;         // online: steps kept (the lag bound)
+  // Batch: smooth each chain along its matched path (path_smoother.hpp), or leave each point
+  // where its fix projects.
+  enum class AlongPath { smoothed, projected } along_path = AlongPath::smoothed;
 
   // Throws std::invalid_argument for a non-positive scale or radius.
   void validate() const;

@@ -1,0 +1,131 @@
+#include "localizer/match/path_smoother.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+namespace corridor::localizer {
+namespace {
+
+// The chain's path as edge occurrences, each with the path distance at its offset 0.
+struct Occurrence {
+  EdgeId edge;
+  double s_start;
+};
+
+}  // namespace
+
+std::vector<MatchedPoint> smooth_along_path(const maps::RoadGraph& g, planner::BoundedDistances& distances,
+                                            std::span<const GpsFix> fixes, std::span<const MatchedPoint> points,
+                                            const SmootherConfig& config) {
+  std::vector<MatchedPoint> out(points.begin(), points.end());
+  const std::size_t n = points.size();
+  if (n < 3 || fixes.size() != n) return out;
+
+  // 1. The path and each point's distance along it.
+  std::vector<Occurrence> path{{points[0].edge, 0.0}};
+  std::vector<double> s(n);
+  s[0] = points[0].offset_m;
+  for (std::size_t i = 1; i < n; ++i) {
+    const MatchedPoint& a = points[i - 1];
+    const MatchedPoint& b = points[i];
+    if (b.edge == path.back().edge && (b.edge == a.edge)) {
+      s[i] = path.back().s_start + b.offset_m;  // along the same edge (a little back is noise)
+      continue;
+    }
+    distances.run(g, g.head(path.back().edge), 5000.0, std::array<NodeId, 1>{g.tail(b.edge)});
+    if (distances.length_m(g.tail(b.edge)) == planner::kInfCost) return out;
+    double at = path.back().s_start + g.length_m(path.back().edge);
+    for (EdgeId e : distances.path_to(g, g.tail(b.edge))) {
+      path.push_back({e, at});
+      at += g.length_m(e);
+    }
+    path.push_back({b.edge, at});
+    s[i] = at + b.offset_m;
+  }
+  // A path much longer than the fixes moved (a loop round a block where noise put a fix behind
+  // the last one) would drag the estimate along it: the chain is smoothed in two parts there.
+  for (std::size_t i = 1; i < n; ++i) {
+    const double dt = std::max(1.0, fixes[i].time_s - fixes[i - 1].time_s);
+    const double moved = maps::distance_m(points[i - 1].point, points[i].point);
+    if (std::abs(s[i] - s[i - 1]) > 2.0 * moved + 10.0 * dt) {
+      auto head = smooth_along_path(g, distances, fixes.first(i), points.first(i), config);
+      const auto tail = smooth_along_path(g, distances, fixes.subspan(i), points.subspan(i), config);
+      head.insert(head.end(), tail.begin(), tail.end());
+      return head;
+    }
+  }
+
+  // 2. Constant-velocity Kalman filter over (s, v), then the RTS smoother.
+  using Vec = std::array<double, 2>;
+  using Mat = std::array<double, 4>;  // row-major 2×2
+  std::vector<Vec> xf(n), xp(n);
+  std::vector<Mat> pf(n), pp(n);
+  const double q = config.acceleration_sigma * config.acceleration_sigma;
+  auto sigma_s = [&](std::size_t i) {
+    const double h = fixes[i].hdop && *fixes[i].hdop > 0.0 ? *fixes[i].hdop : config.default_hdop;
+    return h * config.sigma_base_m;
+  };
+  const double v0 = fixes[0].speed_mps.value_or(n > 1 && fixes[1].time_s > fixes[0].time_s
+                                                    ? (s[1] - s[0]) / (fixes[1].time_s - fixes[0].time_s)
+                                                    : 0.0);
+  xf[0] = {s[0], v0};
+  pf[0] = {std::pow(sigma_s(0), 2), 0.0, 0.0, fixes[0].speed_mps ? std::pow(config.speed_sigma_mps, 2) : 25.0};
+  xp[0] = xf[0];
+  pp[0] = pf[0];
+  for (std::size_t i = 1; i < n; ++i) {
+    const double dt = std::max(0.0, fixes[i].time_s - fixes[i - 1].time_s);
+    const Vec& x = xf[i - 1];
+    const Mat& p = pf[i - 1];
+    // Predict: x = F x, P = F P Fᵀ + Q.
+    Vec x1{x[0] + dt * x[1], x[1]};
+    Mat p1{p[0] + dt * (p[2] + p[1]) + dt * dt * p[3] + q * dt * dt * dt / 3.0, p[1] + dt * p[3] + q * dt * dt / 2.0,
+           p[2] + dt * p[3] + q * dt * dt / 2.0, p[3] + q * dt};
+    xp[i] = x1;
+    pp[i] = p1;
+    // Update with the position along the path, then with the speed if the fix has one.
+    auto update = [&](int row, double z, double r) {
+      const double hx = x1[static_cast<std::size_t>(row)];
+      const double s_var = p1[static_cast<std::size_t>(row * 3)] + r;  // P[row][row] + R
+      const double k0 = p1[static_cast<std::size_t>(row)] / s_var;     // P[0][row] / S
+      const double k1 = p1[static_cast<std::size_t>(2 + row)] / s_var; // P[1][row] / S
+      const double innovation = z - hx;
+      x1 = {x1[0] + k0 * innovation, x1[1] + k1 * innovation};
+      const double pr0 = p1[static_cast<std::size_t>(row * 2)], pr1 = p1[static_cast<std::size_t>(row * 2 + 1)];  // row of P
+      p1 = {p1[0] - k0 * pr0, p1[1] - k0 * pr1, p1[2] - k1 * pr0, p1[3] - k1 * pr1};
+    };
+    update(0, s[i], std::pow(sigma_s(i), 2));
+    if (fixes[i].speed_mps) update(1, *fixes[i].speed_mps, std::pow(config.speed_sigma_mps, 2));
+    xf[i] = x1;
+    pf[i] = p1;
+  }
+  std::vector<Vec> xs(xf);
+  for (std::size_t i = n - 1; i-- > 0;) {
+    const double dt = std::max(0.0, fixes[i + 1].time_s - fixes[i].time_s);
+    const Mat& p = pf[i];
+    const Mat& pn = pp[i + 1];
+    // C = P_f Fᵀ P_pred⁻¹
+    const Mat pft{p[0] + dt * p[1], p[1], p[2] + dt * p[3], p[3]};  // P Fᵀ
+    const double det = pn[0] * pn[3] - pn[1] * pn[2];
+    if (!(std::abs(det) > 1e-12)) continue;
+    const Mat inv{pn[3] / det, -pn[1] / det, -pn[2] / det, pn[0] / det};
+    const Mat c{pft[0] * inv[0] + pft[1] * inv[2], pft[0] * inv[1] + pft[1] * inv[3], pft[2] * inv[0] + pft[3] * inv[2],
+                pft[2] * inv[1] + pft[3] * inv[3]};
+    const Vec d{xs[i + 1][0] - xp[i + 1][0], xs[i + 1][1] - xp[i + 1][1]};
+    xs[i] = {xf[i][0] + c[0] * d[0] + c[1] * d[1], xf[i][1] + c[2] * d[0] + c[3] * d[1]};
+  }
+
+  // 3. Back onto the path.
+  const double s_end = path.back().s_start + g.length_m(path.back().edge);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double at = std::clamp(xs[i][0], 0.0, s_end);
+    auto it = std::upper_bound(path.begin(), path.end(), at, [](double v, const Occurrence& o) { return v < o.s_start; });
+    const Occurrence& o = it == path.begin() ? path.front() : *std::prev(it);
+    out[i].edge = o.edge;
+    out[i].offset_m = std::clamp(at - o.s_start, 0.0, g.length_m(o.edge));
+    out[i].point = g.point_along(o.edge, out[i].offset_m);
+  }
+  return out;
+}
+
+}  // namespace corridor::localizer

@@ -1,0 +1,33 @@
+// Smooths a matched chain along its own path. Matching projects each fix onto the road, which
+// removes the error across the road but keeps the error along it (σ of the GPS); a vehicle's
+// distance along its path changes smoothly, and receivers measure speed well (Doppler). So the
+// distance driven is estimated with a constant-velocity Kalman filter over the fixes' projections
+// and speeds, and a Rauch–Tung–Striebel pass backwards (batch), then mapped back onto the path's
+// edges. This is what brings the error along the road down, and with it the wrong-edge choices
+// that a few metres of along-road error cause at junctions.
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "localizer/match/gps_fix.hpp"
+#include "maps/road_graph.hpp"
+#include "planner/bounded_search.hpp"
+
+namespace corridor::localizer {
+
+struct SmootherConfig {
+  double acceleration_sigma = 1.5;   // m/s², the process noise of the constant-velocity model
+  double speed_sigma_mps = 0.5;      // of a receiver's speed
+  double sigma_base_m = 4.0;         // position σ = HDOP × this, as the matcher's emission
+  double default_hdop = 1.5;
+};
+
+// `points` is one unbroken chain matched from `fixes` (same length, every point matched). Returns
+// the smoothed points; where the path between two points cannot be rebuilt, the chain is returned
+// unchanged.
+std::vector<MatchedPoint> smooth_along_path(const maps::RoadGraph& graph, planner::BoundedDistances& distances,
+                                            std::span<const GpsFix> fixes, std::span<const MatchedPoint> points,
+                                            const SmootherConfig& config = {});
+
+}  // namespace corridor::localizer
