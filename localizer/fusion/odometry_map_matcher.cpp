@@ -79,6 +79,9 @@ MatchedPoint OdometryMapMatcher::advance(const OdometryStep& step) {
       if (past_junction_m_ >= config_.decision_m) {
         const double turn = wrap180(heading_deg_ - heading_at_junction_deg_);
         exits_.clear();
+        // The heading check compares the road with the headings driven on it, not before the turn.
+        headings_.clear();
+        headings_.emplace_back(step.time_s, heading_deg_);
         if (std::abs(turn) > config_.reset_turn_deg && edge_ != came_from_) {
           // A sharp turn happened at a known junction: the along-road drift is gone (§IV's reset).
           sigma_m_ = config_.base_sigma_m;

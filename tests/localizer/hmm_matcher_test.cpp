@@ -10,51 +10,14 @@
 #include <numbers>
 #include <random>
 
-#include "maps/graph_builder.hpp"
+#include "tests/localizer/sketch_graph.hpp"
 #include "maps/synthetic_grid.hpp"
 #include "planner/route.hpp"
 
 namespace corridor::localizer {
 namespace {
 
-// A graph from polylines in the local frame: each road is a list of node indices (two-way unless
-// one-way), with straight geometry between them.
-struct Sketch {
-  std::vector<maps::Point2> nodes;
-  struct Road {
-    std::vector<std::uint32_t> through;
-    bool oneway = false;
-    std::int64_t way = 0;
-  };
-  std::vector<Road> roads;
-
-  maps::RoadGraph build() const {
-    maps::GraphBuildInput in;
-    in.origin = {47.0, 9.5};
-    in.node_pos = nodes;
-    for (std::size_t i = 0; i < nodes.size(); ++i) {
-      in.node_osm.push_back(OsmNodeId{static_cast<std::int64_t>(i + 1)});
-      in.node_signalized.push_back(0);
-    }
-    for (const Road& r : roads) {
-      for (std::size_t k = 1; k < r.through.size(); ++k) {
-        maps::RoadSegment s;
-        s.from = r.through[k - 1];
-        s.to = r.through[k];
-        s.first_point = static_cast<std::uint32_t>(in.points.size());
-        in.points.push_back(nodes[s.from]);
-        in.points.push_back(nodes[s.to]);
-        s.last_point = s.first_point + 1;
-        s.forward = true;
-        s.backward = !r.oneway;
-        s.forward_speed_mps = s.backward_speed_mps = 14.0f;
-        s.way = OsmWayId{r.way};
-        in.segments.push_back(s);
-      }
-    }
-    return maps::build_road_graph(in);
-  }
-};
+using testing::Sketch;
 
 GpsFix fix_at(const maps::RoadGraph& g, double t, maps::Point2 p, std::optional<double> heading = {},
               std::optional<double> speed = {}) {
