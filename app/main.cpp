@@ -8,6 +8,7 @@
 #include "app/bench_command.hpp"
 #include "app/cli_error.hpp"
 #include "app/experiment_command.hpp"
+#include "app/localize_command.hpp"
 #include "app/map_command.hpp"
 #include "app/match_command.hpp"
 #include "app/preemption_command.hpp"
@@ -37,6 +38,7 @@ int main(int argc, char** argv) {
   corridor::app::register_sim_command(app);
   corridor::app::register_vo_command(app);
   corridor::app::register_match_command(app);
+  corridor::app::register_localize_command(app);
 
   try {
     app.parse(argc, argv);

@@ -236,6 +236,16 @@ StereoSequence open_or_usage(const std::string& dir) {
   return open_stereo_sequence(dir);
 }
 
+}  // namespace
+
+std::vector<localizer::Pose> vo_poses(const std::filesystem::path& sequence, double* frame_rate_hz) {
+  const localizer::StereoSequence seq = localizer::open_stereo_sequence(sequence);
+  if (frame_rate_hz != nullptr) *frame_rate_hz = seq.frame_rate_hz;
+  return run_sequence(seq, localizer::OdometryOptions{}, 0).poses;
+}
+
+namespace {
+
 void run_vo(const RunOptions& o) {
   const auto options = odometry_options(o);
   if (o.max_frames < 0) throw UsageError("--max-frames must be ≥ 0");

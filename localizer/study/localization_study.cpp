@@ -23,8 +23,8 @@ double bearing_deg(const maps::RoadGraph& g, EdgeId e, double offset_m) {
   return std::atan2(b.x_m - a.x_m, b.y_m - a.y_m) * 180.0 / std::numbers::pi;
 }
 
-// The edge the vehicle truly drives: the nearest road point within the radius whose direction
-// agrees with the vehicle's heading.
+}  // namespace
+
 EdgeId true_edge(const maps::RoadGraph& g, const maps::EdgeSnapper& snapper, maps::Point2 p, double heading_deg,
                  double radius_m) {
   EdgeId best;
@@ -38,6 +38,8 @@ EdgeId true_edge(const maps::RoadGraph& g, const maps::EdgeSnapper& snapper, map
   }
   return best;
 }
+
+namespace {
 
 bool same_road(const maps::RoadGraph& g, EdgeId a, EdgeId b) { return a == b || (a.valid() && g.twin(a) == b); }
 

@@ -59,6 +59,11 @@ StudyResult run_localization_study(const maps::RoadGraph& graph, const maps::Edg
                                    const std::map<std::string, std::vector<TruthSample>>& drives, const StudyConfig& config,
                                    const std::string& plot_id = "", DrivePlot* plot = nullptr);
 
+// The edge a vehicle truly drives at `p` (local frame) with `heading_deg`: the nearest road point
+// within radius_m whose direction agrees with the heading within 60°; invalid if none.
+EdgeId true_edge(const maps::RoadGraph& graph, const maps::EdgeSnapper& snapper, maps::Point2 p, double heading_deg,
+                 double radius_m);
+
 // An SVG of one drive: truth, raw GPS dots, HMM-matched and fused tracks, the outage highlighted,
 // over the roads near it.
 std::string drive_plot_svg(const maps::RoadGraph& graph, const DrivePlot& plot, const std::string& title);

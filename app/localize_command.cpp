@@ -1,0 +1,261 @@
+#include "app/localize_command.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <iostream>
+#include <numbers>
+#include <random>
+#include <sstream>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "app/cli_error.hpp"
+#include "app/map_options.hpp"
+#include "app/vo_command.hpp"
+#include "localizer/fusion/gps_odometry_localizer.hpp"
+#include "localizer/match/trace_io.hpp"
+#include "localizer/study/localization_study.hpp"
+#include "sim/corridor_client.hpp"
+
+namespace corridor::app {
+namespace {
+
+using nlohmann::json;
+
+struct LocalizeOptions {
+  MapOptions map;
+  std::string gps;
+  std::string seq;
+  std::string truth;
+  bool json = false;
+  std::string out;
+  // Simulated GPS from the truth, when no --gps is given.
+  double gps_noise_m = 5.0;
+  double gps_rate_hz = 1.0;
+  std::vector<std::string> gps_outages;
+  std::uint64_t seed = 1;
+  // Live feed.
+  std::string server;
+  std::string vehicle;
+  std::string token;
+  double speedup = 1.0;
+};
+
+struct TruthRow {
+  double time_s;
+  maps::Point2 position;
+  double heading_deg;  // clockwise from north
+};
+
+// drive.csv from `corridor vo synth`: frame,time_s,x_m,y_m,heading_rad,arc_m (map frame).
+std::vector<TruthRow> read_drive_csv(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw UsageError("truth file not found: '" + path + "'");
+  std::string line;
+  std::getline(in, line);
+  if (line.rfind("frame,time_s,x_m,y_m,heading_rad", 0) != 0) {
+    throw UsageError("'" + path + "' is not a drive.csv (frame,time_s,x_m,y_m,heading_rad,arc_m)");
+  }
+  std::vector<TruthRow> rows;
+  while (std::getline(in, line)) {
+    std::stringstream ss(line);
+    std::string f;
+    std::vector<double> v;
+    while (std::getline(ss, f, ',')) v.push_back(std::stod(f));
+    if (v.size() < 5) throw UsageError("'" + path + "': short line");
+    // heading_rad is counter-clockwise from east; the map's headings are clockwise from north.
+    rows.push_back({v[1], {v[2], v[3]}, std::fmod(90.0 - v[4] * 180.0 / std::numbers::pi + 720.0, 360.0)});
+  }
+  if (rows.size() < 2) throw UsageError("'" + path + "' has no drive");
+  return rows;
+}
+
+std::vector<std::pair<double, double>> parse_outages(const std::vector<std::string>& specs) {
+  std::vector<std::pair<double, double>> out;
+  for (const std::string& s : specs) {
+    const auto colon = s.find(':');
+    try {
+      if (colon == std::string::npos) throw std::invalid_argument(s);
+      const double start = std::stod(s.substr(0, colon)), dur = std::stod(s.substr(colon + 1));
+      if (!(start >= 0.0) || !(dur > 0.0)) throw std::invalid_argument(s);
+      out.emplace_back(start, start + dur);
+    } catch (const std::exception&) {
+      throw UsageError("--gps-outage expects START:DURATION in seconds, got '" + s + "'");
+    }
+  }
+  return out;
+}
+
+void run_localize(const LocalizeOptions& o) {
+  if (o.gps.empty() && o.truth.empty()) throw UsageError("give --gps, or --truth to simulate GPS from");
+  if (o.seq.empty() && o.truth.empty()) throw UsageError("give --seq (stereo odometry), or --truth to simulate odometry from");
+  if (!(o.gps_rate_hz > 0.0 && o.gps_rate_hz <= 50.0) || !(o.gps_noise_m >= 0.0) || !(o.speedup > 0.0)) {
+    throw UsageError("--gps-rate-hz must be in (0, 50], --gps-noise-m >= 0 and --speedup > 0");
+  }
+  if (!o.server.empty() && (o.vehicle.empty() || o.token.empty())) throw UsageError("--server needs --vehicle and --token");
+  const auto outages = parse_outages(o.gps_outages);
+  const maps::RoadGraph graph = load_map_from_options(o.map);
+  const maps::EdgeSnapper snapper(graph);
+  const std::vector<TruthRow> truth = o.truth.empty() ? std::vector<TruthRow>{} : read_drive_csv(o.truth);
+
+  // GPS: from the file, or from the truth with noise, dropped inside the outages.
+  std::vector<localizer::GpsFix> gps;
+  if (!o.gps.empty()) {
+    gps = localizer::read_trace(o.gps);
+  } else {
+    std::mt19937_64 rng(o.seed);
+    std::normal_distribution<double> noise(0.0, o.gps_noise_m);
+    std::size_t k = 0;
+    for (double t = truth.front().time_s; t <= truth.back().time_s; t += 1.0 / o.gps_rate_hz) {
+      while (k + 1 < truth.size() && truth[k + 1].time_s <= t) ++k;
+      const bool out = std::any_of(outages.begin(), outages.end(), [&](const auto& w) { return t >= w.first && t < w.second; });
+      if (out) continue;
+      localizer::GpsFix f;
+      f.time_s = t;
+      f.position = graph.projection().to_lat_lon({truth[k].position.x_m + noise(rng), truth[k].position.y_m + noise(rng)});
+      f.hdop = std::max(1.0, o.gps_noise_m / 4.0);
+      gps.push_back(f);
+    }
+  }
+
+  // Odometry: the stereo VO's poses, or the truth with the VO's measured drift.
+  std::vector<localizer::OdometryStep> odometry;
+  if (!o.seq.empty()) {
+    double rate = 10.0;
+    const auto poses = vo_poses(o.seq, &rate);
+    for (std::size_t i = 1; i < poses.size(); ++i) {
+      const Eigen::Isometry3d step = poses[i - 1].inverse() * poses[i];
+      const Eigen::Matrix3d r = step.rotation();
+      // KITTI camera frame: x right, y down, z forward; a right turn swings z towards x.
+      const double yaw_deg = std::atan2(r(0, 2), r(2, 2)) * 180.0 / std::numbers::pi;
+      odometry.push_back({static_cast<double>(i) / rate, step.translation().norm(), yaw_deg});
+    }
+  } else {
+    std::mt19937_64 rng(o.seed + 1);
+    std::normal_distribution<double> gauss(0.0, 1.0);
+    const double scale = 1.0 + 0.0062 * gauss(rng);
+    for (std::size_t i = 1; i < truth.size(); ++i) {
+      const double d = maps::distance_m(truth[i - 1].position, truth[i].position);
+      double turn = std::fmod(truth[i].heading_deg - truth[i - 1].heading_deg + 540.0, 360.0) - 180.0;
+      turn += 0.24 * d / 100.0 * gauss(rng);
+      odometry.push_back({truth[i].time_s, d * scale, turn});
+    }
+  }
+
+  // Fuse in time order; one output per GPS period.
+  localizer::GpsOdometryLocalizer fusion(graph, snapper);
+  const double t_begin = std::min(gps.empty() ? 1e18 : gps.front().time_s, odometry.empty() ? 1e18 : odometry.front().time_s);
+  const double t_end = std::max(gps.empty() ? -1e18 : gps.back().time_s, odometry.empty() ? -1e18 : odometry.back().time_s);
+  std::size_t gi = 0, oi = 0;
+  std::unique_ptr<sim::CorridorClient> client;
+  if (!o.server.empty()) client = std::make_unique<sim::CorridorClient>(o.server, o.token);
+  const double epoch = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+  const auto wall_start = std::chrono::steady_clock::now();
+  json points = json::array();
+  std::size_t posted_gps = 0, posted_vo = 0, completed_at = 0;
+  bool completed = false;
+  double sq = 0.0;
+  std::size_t scored = 0, on_edge = 0, outage_scored = 0, outage_on_edge = 0;
+  std::size_t tk = 0;
+  for (double t = t_begin; t <= t_end + 1e-9; t += 1.0 / o.gps_rate_hz) {
+    while (oi < odometry.size() && odometry[oi].time_s <= t + 1e-9) fusion.on_odometry(odometry[oi++]);
+    std::optional<double> hdop;
+    while (gi < gps.size() && gps[gi].time_s <= t + 1e-9) {
+      hdop = gps[gi].hdop;
+      fusion.on_gps(gps[gi++]);
+    }
+    const localizer::LocalizedPoint& p = fusion.last();
+    if (p.source == localizer::PositionSource::none) continue;
+    json j{{"time_s", t},
+           {"lat", p.position.lat_deg},
+           {"lon", p.position.lon_deg},
+           {"heading_deg", p.heading_deg},
+           {"edge", p.match.edge.v},
+           {"osm_way_id", graph.osm_way(p.match.edge).v},
+           {"name", graph.name(p.match.edge)},
+           {"offset_m", p.match.offset_m},
+           {"sigma_m", p.sigma_m},
+           {"source", localizer::to_string(p.source)}};
+    if (!truth.empty()) {
+      while (tk + 1 < truth.size() && truth[tk + 1].time_s <= t) ++tk;
+      const double err = maps::distance_m(p.match.point, truth[tk].position);
+      const EdgeId te = localizer::true_edge(graph, snapper, truth[tk].position, truth[tk].heading_deg, 20.0);
+      const bool right = te.valid() && te == p.match.edge;
+      sq += err * err;
+      ++scored;
+      on_edge += right ? 1 : 0;
+      const bool out = std::any_of(outages.begin(), outages.end(), [&](const auto& w) { return t >= w.first && t < w.second; });
+      if (out && te.valid()) {
+        ++outage_scored;
+        outage_on_edge += right ? 1 : 0;
+      }
+      j["error_m"] = err;
+    }
+    if (client) {
+      // At the sequence's pace (or faster), with the source and HDOP as they were.
+      const auto due = wall_start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                        std::chrono::duration<double>((t - t_begin) / o.speedup));
+      std::this_thread::sleep_until(due);
+      json body{{"lat", p.position.lat_deg}, {"lon", p.position.lon_deg}, {"heading_deg", p.heading_deg},
+                {"timestamp", epoch + (t - t_begin)}, {"source", p.source == localizer::PositionSource::gps ? "gps" : "vo"}};
+      if (p.source == localizer::PositionSource::gps && hdop) body["hdop"] = *hdop;
+      const json answer = client->post("/v1/vehicles/" + o.vehicle + "/position", body);
+      (p.source == localizer::PositionSource::gps ? posted_gps : posted_vo) += 1;
+      if (!completed && answer.value("completed", false)) {
+        completed = true;
+        completed_at = points.size();
+      }
+    }
+    points.push_back(std::move(j));
+  }
+  if (points.empty()) throw UsageError("nothing could be localized: no GPS fix matched the map");
+  json summary{{"positions", points.size()}, {"gps_fixes", gps.size()}, {"odometry_steps", odometry.size()}};
+  if (!truth.empty()) {
+    summary["rmse_m"] = std::sqrt(sq / static_cast<double>(std::max<std::size_t>(1, scored)));
+    summary["correct_edge_share"] = scored > 0 ? static_cast<double>(on_edge) / static_cast<double>(scored) : 0.0;
+    summary["outage_correct_edge_share"] =
+        outage_scored > 0 ? json(static_cast<double>(outage_on_edge) / static_cast<double>(outage_scored)) : json(nullptr);
+  }
+  if (client) {
+    summary["posted_gps"] = posted_gps;
+    summary["posted_vo"] = posted_vo;
+    summary["mission_completed"] = completed;
+    summary["completed_at_position"] = completed ? json(completed_at) : json(nullptr);
+  }
+  if (!o.out.empty()) {
+    std::ofstream out(o.out);
+    if (!out) throw UsageError("cannot write --out '" + o.out + "'");
+    out << points.dump() << '\n';
+  }
+  if (o.json) {
+    std::cout << json{{"summary", summary}, {"points", points}}.dump() << '\n';
+  } else {
+    std::cout << summary.dump(2) << '\n';
+  }
+}
+
+}  // namespace
+
+void register_localize_command(CLI::App& app) {
+  auto o = std::make_shared<LocalizeOptions>();
+  auto* cmd = app.add_subcommand("localize", "Fuse GPS and stereo odometry on a map; optionally feed a live server");
+  add_map_options(*cmd, o->map);
+  cmd->add_option("--gps", o->gps, "GPS trace (GPX or CSV time,lat,lon[,hdop,heading_deg,speed_mps]); else simulated from --truth");
+  cmd->add_option("--seq", o->seq, "KITTI-layout stereo sequence for the odometry; else simulated from --truth");
+  cmd->add_option("--truth", o->truth, "drive.csv from corridor vo synth: scores the output and feeds the simulations");
+  cmd->add_flag("--json", o->json, "print the summary and every position as JSON");
+  cmd->add_option("--out", o->out, "write the positions as a JSON array");
+  cmd->add_option("--gps-noise-m", o->gps_noise_m, "simulated GPS noise σ")->capture_default_str();
+  cmd->add_option("--gps-rate-hz", o->gps_rate_hz, "simulated GPS rate, and the output rate")->capture_default_str();
+  cmd->add_option("--gps-outage", o->gps_outages, "START:DURATION seconds without simulated GPS (repeatable)");
+  cmd->add_option("--seed", o->seed, "simulation seed")->capture_default_str();
+  cmd->add_option("--server", o->server, "post each position to this corridor serve (http://host:port)");
+  cmd->add_option("--vehicle", o->vehicle, "with --server: the vehicle id");
+  cmd->add_option("--token", o->token, "with --server: a token with the vehicle or dispatcher role");
+  cmd->add_option("--speedup", o->speedup, "with --server: post this many times faster than real time")->capture_default_str();
+  cmd->callback([o] { run_localize(*o); });
+}
+
+}  // namespace corridor::app
