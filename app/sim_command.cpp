@@ -33,6 +33,9 @@ struct SimOptions {
   std::uint32_t incidents = 2;
   bool libsumo = false;
   std::string server;
+  double gps_noise_m = 0.0;
+  double gps_rate_hz = 1.0;
+  std::vector<std::string> gps_outages;
   std::string token;
 };
 
@@ -68,6 +71,25 @@ void run_sim(const SimOptions& o) {
   c.incidents = o.incidents;
   c.backend = o.libsumo ? sim::SumoBackend::libsumo : sim::SumoBackend::traci;
   c.server_url = o.server;
+  if ((o.gps_noise_m != 0.0 || !o.gps_outages.empty()) && o.server.empty()) {
+    throw UsageError("--gps-noise-m and --gps-outage feed the server's map matcher: give --server");
+  }
+  if (!(o.gps_noise_m >= 0.0) || !(o.gps_rate_hz > 0.0 && o.gps_rate_hz <= 10.0)) {
+    throw UsageError("--gps-noise-m must be >= 0 and --gps-rate-hz in (0, 10]");
+  }
+  if (!o.gps_outages.empty() && !(o.gps_noise_m > 0.0)) throw UsageError("--gps-outage needs --gps-noise-m > 0");
+  c.gps_noise_m = o.gps_noise_m;
+  c.gps_rate_hz = o.gps_rate_hz;
+  for (const std::string& spec : o.gps_outages) {
+    const auto colon = spec.find(':');
+    double start = -1, duration = -1;
+    try {
+      if (colon != std::string::npos) start = std::stod(spec.substr(0, colon)), duration = std::stod(spec.substr(colon + 1));
+    } catch (const std::exception&) {
+    }
+    if (!(start >= 0.0) || !(duration > 0.0)) throw UsageError("--gps-outage expects START:DURATION in seconds after the EV departs, got '" + spec + "'");
+    c.gps_outages.emplace_back(start, start + duration);
+  }
   c.server_token = o.token;
   if (!o.server.empty() && o.token.empty()) {
     const char* env = std::getenv("CORRIDOR_TOKEN");
@@ -112,6 +134,11 @@ void register_sim_command(CLI::App& app) {
   cmd->add_option("--server", o->server,
                   "run the loop through this corridor serve (http://host:port), started with --map on the same .net.xml");
   cmd->add_option("--token", o->token, "bearer token for --server (default $CORRIDOR_TOKEN)");
+  cmd->add_option("--gps-noise-m", o->gps_noise_m, "with --server: post noisy GPS fixes (σ in m) instead of SUMO's true positions")
+      ->capture_default_str();
+  cmd->add_option("--gps-rate-hz", o->gps_rate_hz, "with --gps-noise-m: fixes per second")->capture_default_str();
+  cmd->add_option("--gps-outage", o->gps_outages,
+                  "with --gps-noise-m: START:DURATION s after the EV departs with HDOP > 10 fixes; onboard odometry posts source vo");
   cmd->callback([o] { run_sim(*o); });
 }
 

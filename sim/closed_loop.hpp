@@ -44,6 +44,13 @@ struct ClosedLoopConfig {
   std::filesystem::path background_routes;
   std::filesystem::path out_dir;  // logs and tripinfo of this run
   std::string run_name = "run";
+  // With a server: what the EV's receiver reports. 0 m posts SUMO's true positions, as before;
+  // otherwise fixes with this Gaussian noise at gps_rate_hz, and inside each outage (seconds after
+  // the EV departs, start and end) fixes with HDOP above 10 while the EV's onboard localizer posts
+  // source "vo" positions from odometry simulated from SUMO's truth with our VO's measured drift.
+  double gps_noise_m = 0.0;
+  double gps_rate_hz = 1.0;
+  std::vector<std::pair<double, double>> gps_outages;
 };
 
 struct ClosedLoopResult {

@@ -8,6 +8,9 @@
 #include <map>
 #include <thread>
 
+#include <random>
+
+#include "localizer/fusion/gps_odometry_localizer.hpp"
 #include "sim/closed_loop_run.hpp"
 #include "sim/corridor_client.hpp"
 
@@ -73,6 +76,14 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
 
   ClosedLoopResult result;
   const std::string vehicle = "ev-" + config.run_name;
+  // The EV's receiver and onboard localizer (only with gps_noise_m > 0).
+  const maps::EdgeSnapper snapper(g);
+  localizer::GpsOdometryLocalizer onboard(g, snapper);
+  std::mt19937_64 rng(config.seed * 7919 + 3);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  const double odometry_scale = 1.0 + 0.0062 * gauss(rng);  // docs/experiments/vo.md: t_err 0.62 %
+  std::optional<std::pair<maps::Point2, double>> last_truth;  // position, angle
+  double last_fix_s = -1e9;
   std::optional<std::uint64_t> mission;
   std::vector<std::string> route;
   bool ev_added = false, ev_seen = false, ev_done = false;
@@ -160,10 +171,54 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
         ev_seen = true;
         const std::string road = as_string(ev, libsumo::VAR_ROAD_ID);
         const auto pos = std::dynamic_pointer_cast<libsumo::TraCIPosition>(ev.at(libsumo::VAR_POSITION));
-        if (!road.empty() && road[0] != ':' && pos) {
-          const json res = server.post("/v1/vehicles/" + vehicle + "/position",
-                                       position_json(g, {pos->x, pos->y}, as_double(ev, libsumo::VAR_ANGLE),
-                                                     as_double(ev, libsumo::VAR_SPEED), now));
+        std::optional<json> report;
+        const double sumo_angle = as_double(ev, libsumo::VAR_ANGLE);
+        // SUMO reports an invalid value (-2^30) before the vehicle is on the road.
+        if (pos && config.gps_noise_m > 0.0 && !road.empty() && sumo_angle >= 0.0 && sumo_angle <= 360.0) {
+          // The receiver and the onboard localizer: odometry every step, a fix at the GPS rate.
+          const maps::Point2 truth{pos->x, pos->y};
+          const double angle = as_double(ev, libsumo::VAR_ANGLE);
+          if (last_truth) {
+            const double d = maps::distance_m(last_truth->first, truth);
+            const double turn = std::fmod(angle - last_truth->second + 540.0, 360.0) - 180.0 + 0.24 * d / 100.0 * gauss(rng);
+            onboard.on_odometry({t, d * odometry_scale, turn});
+          }
+          last_truth = {truth, angle};
+          const double since = t - ev_depart;
+          const bool out = std::any_of(config.gps_outages.begin(), config.gps_outages.end(),
+                                       [&](const auto& w) { return since >= w.first && since < w.second; });
+          if (t - last_fix_s >= 1.0 / config.gps_rate_hz - 1e-9) {
+            last_fix_s = t;
+            const double sigma = out ? 40.0 : config.gps_noise_m;  // multipath under a roof of buildings
+            const maps::Point2 noisy{truth.x_m + sigma * gauss(rng), truth.y_m + sigma * gauss(rng)};
+            const double hdop = out ? 15.0 : std::max(1.0, config.gps_noise_m / 4.0);
+            json fix = position_json(g, noisy, std::fmod(angle + 5.0 * gauss(rng) + 360.0, 360.0),
+                                     as_double(ev, libsumo::VAR_SPEED), now);
+            fix["hdop"] = hdop;
+            localizer::GpsFix f;
+            f.time_s = t;
+            f.position = g.projection().to_lat_lon(noisy);
+            f.hdop = hdop;
+            onboard.on_gps(f);
+            if (!out) {
+              report = std::move(fix);
+            } else {
+              // The bad fix is reported honestly (the server stores it as low_accuracy) and the
+              // onboard odometry's position follows as source "vo".
+              (void)server.post("/v1/vehicles/" + vehicle + "/position", fix);
+              const localizer::LocalizedPoint& p = onboard.last();
+              if (p.source == localizer::PositionSource::odometry) {
+                json vo = position_json(g, p.match.point, p.heading_deg, as_double(ev, libsumo::VAR_SPEED), now + 1e-3);
+                vo["source"] = "vo";
+                report = std::move(vo);
+              }
+            }
+          }
+        } else if (!road.empty() && road[0] != ':' && pos) {
+          report = position_json(g, {pos->x, pos->y}, as_double(ev, libsumo::VAR_ANGLE), as_double(ev, libsumo::VAR_SPEED), now);
+        }
+        if (report) {
+          const json res = server.post("/v1/vehicles/" + vehicle + "/position", *report);
           if (res.value("route_changed", false) && mission) {
             const auto fresh = sumo_route_of(sg, server.get("/v1/missions/" + std::to_string(*mission)));
             if (!fresh.empty() && fresh.front() == road && fresh != route) {

@@ -83,6 +83,35 @@ PY
 then
   failures=$((failures + 1))
 fi
+# Noisy GPS with an outage: the loop posts noisy fixes, HDOP over 10 in the outage, and the EV's
+# onboard odometry as source "vo" meanwhile; the server's matcher keeps the mission on track.
+"$corridor" sim --scenario "$work/small.net.xml" --work-dir "$work/server-run" --volume 300 --seed 2 --ev-depart-s 5 \
+  --server "http://127.0.0.1:$port" --token "$token" --gps-noise-m 5 --gps-outage 5:20 > "$work/noisy.json"
+if ! /usr/bin/python3 - "$work/noisy.json" "$work/server.db" <<'PY'
+import json, sqlite3, sys
+a = json.load(open(sys.argv[1]))
+db = sqlite3.connect(sys.argv[2])
+counts = dict(((s, d), n) for s, d, n in db.execute(
+    "SELECT source, disposition, COUNT(*) FROM positions WHERE vehicle_id='ev-dynamic_corridor' GROUP BY 1, 2"))
+states = [s for (s,) in db.execute("SELECT state FROM missions ORDER BY id")]
+problems = []
+if not a["ev_arrived"]: problems.append("the EV did not arrive with noisy GPS")
+if counts.get(("vo", "followed"), 0) < 5: problems.append(f"too few odometry positions followed: {counts}")
+if counts.get(("gps", "low_accuracy"), 0) < 5: problems.append(f"the outage's fixes were not flagged: {counts}")
+if states[-1] != "completed": problems.append(f"the noisy mission ended {states[-1]}")
+if a["lights_back_on_program"] != a["lights_taken_over"]: problems.append("a light was not restored")
+print(f"noisy: travel {a['ev_travel_time_s']} s, positions {counts}")
+for p in problems: print(f"FAIL noisy GPS: {p}")
+sys.exit(1 if problems else 0)
+PY
+then
+  failures=$((failures + 1))
+fi
+# GPS options need a server.
+if "$corridor" sim --scenario grid --work-dir "$work/x" --gps-noise-m 5 > /dev/null 2> "$work/gps.txt" || ! grep -q "give --server" "$work/gps.txt"; then
+  echo "FAIL: --gps-noise-m without --server was not refused: $(cat "$work/gps.txt")"
+  failures=$((failures + 1))
+fi
 # A server on another map is refused with a clear message.
 set +e
 "$corridor" sim --scenario grid --work-dir "$work/wrong" --server "http://127.0.0.1:$port" --token "$token" \
