@@ -1879,6 +1879,29 @@ export interface components {
             route_changed: boolean;
             /** @description Distance from the report to the road it was snapped to */
             snap_distance_m: number | null;
+            /** @description The report moved the vehicle (false: stored only) */
+            followed: boolean;
+            /**
+             * @description What the vehicle tracker made of the report: followed, or stored only as older than the last accepted one, the same again, a jump faster than a vehicle drives, or GPS with HDOP over 10
+             * @enum {string}
+             */
+            disposition: "followed" | "stale" | "duplicate" | "outlier" | "low_accuracy";
+            /** @description The fix as received */
+            raw: {
+                lat: number;
+                lon: number;
+                timestamp: number;
+                source: string;
+            };
+            /** @description The edge the vehicle's map matcher put it on */
+            edge: number | null;
+            osm_way_id?: number;
+            /** @description The street's name */
+            name?: string;
+            /** @description Along the matched edge */
+            offset_m?: number;
+            /** @description The matcher's probability share for the chosen road point, 0..1 */
+            match_confidence: number | null;
         };
     };
     responses: never;
