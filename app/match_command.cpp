@@ -106,6 +106,9 @@ void run_match(const MatchOptions& o) {
     }
     points.push_back(std::move(p));
   }
+  if (matched_count == 0) {
+    throw localizer::TraceError("no fix of the trace is within reach of a road on this map (is it the right map?)");
+  }
   const json route = matched_route(graph, matched);
   const double per_s = took_s > 0.0 ? static_cast<double>(trace.size()) / took_s : 0.0;
   if (!o.out.empty()) {
@@ -156,6 +159,7 @@ json drive_json(const localizer::DriveResult& d) {
           {"rmse_raw_m", rmse(d.sq_raw, d.n_raw)},
           {"rmse_nearest_m", rmse(d.sq_nearest, d.n_raw)},
           {"rmse_hmm_m", rmse(d.sq_hmm, d.n_hmm)},
+          {"hmm_matched_share", ratio(static_cast<double>(d.n_hmm), static_cast<double>(d.n_raw))},
           {"rmse_fused_m", rmse(d.sq_fused, d.n_fused)},
           {"correct_edge_hmm_by_time", ratio(static_cast<double>(d.correct_hmm), truth)},
           {"correct_edge_hmm_by_length", ratio(d.length_correct_hmm, d.length_with_truth)},
