@@ -1,5 +1,7 @@
 #include "server/dispatch_service.hpp"
 
+#include "localizer/match/bearing.hpp"
+
 #include <boost/asio/thread_pool.hpp>
 #include <spdlog/spdlog.h>
 
@@ -38,13 +40,9 @@ ApiError snap_error(const maps::SnapError& e, const char* what) {
   return unprocessable(code, std::string(what) + ": " + e.what());
 }
 
+using localizer::angle_between_deg;
 // Compass bearing of edge e around offset, degrees clockwise from north.
-double bearing_deg(const maps::RoadGraph& g, EdgeId e, double offset_m) {
-  const double len = g.length_m(e);
-  const maps::Point2 a = g.point_along(e, std::max(0.0, offset_m - 1.0));
-  const maps::Point2 b = g.point_along(e, std::min(len, offset_m + 1.0));
-  return std::fmod(std::atan2(b.x_m - a.x_m, b.y_m - a.y_m) * 180.0 / M_PI + 360.0, 360.0);
-}
+double bearing_deg(const maps::RoadGraph& g, EdgeId e, double offset_m) { return localizer::road_bearing_deg(g, e, offset_m, 1.0); }
 
 DispatchEvent position_event(const PositionReport& p, double now_s, MissionId mission, std::optional<double> eta_s) {
   DispatchEvent e;
@@ -61,10 +59,6 @@ DispatchEvent position_event(const PositionReport& p, double now_s, MissionId mi
   return e;
 }
 
-double angle_between_deg(double a, double b) {
-  const double d = std::fmod(std::abs(a - b), 360.0);
-  return d > 180.0 ? 360.0 - d : d;
-}
 
 }  // namespace
 

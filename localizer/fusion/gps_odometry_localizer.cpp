@@ -1,5 +1,7 @@
 #include "localizer/fusion/gps_odometry_localizer.hpp"
 
+#include "localizer/match/bearing.hpp"
+
 #include <cmath>
 #include <numbers>
 
@@ -19,11 +21,7 @@ GpsOdometryLocalizer::GpsOdometryLocalizer(const maps::RoadGraph& graph, const m
     : graph_(graph), config_(config), hmm_(graph, snapper, config.hmm), odometry_(graph, config.odometry) {}
 
 double GpsOdometryLocalizer::road_heading_deg(EdgeId e, double offset_m) const {
-  const double len = graph_.length_m(e);
-  const maps::Point2 a = graph_.point_along(e, std::clamp(offset_m - 3.0, 0.0, len));
-  const maps::Point2 b = graph_.point_along(e, std::clamp(offset_m + 3.0, 0.0, len));
-  double h = std::atan2(b.x_m - a.x_m, b.y_m - a.y_m) * 180.0 / std::numbers::pi;
-  return h < 0.0 ? h + 360.0 : h;
+  return road_bearing_deg(graph_, e, offset_m, 3.0);
 }
 
 LocalizedPoint GpsOdometryLocalizer::output(PositionSource source, const MatchedPoint& m, double sigma_m) {

@@ -1,17 +1,13 @@
 #include "localizer/fusion/odometry_map_matcher.hpp"
 
+#include "localizer/match/bearing.hpp"
+
 #include <cmath>
 #include <numbers>
 
 namespace corridor::localizer {
 namespace {
 
-double wrap180(double d) {
-  d = std::fmod(d, 360.0);
-  if (d <= -180.0) d += 360.0;
-  if (d > 180.0) d -= 360.0;
-  return d;
-}
 
 }  // namespace
 
@@ -19,10 +15,7 @@ OdometryMapMatcher::OdometryMapMatcher(const maps::RoadGraph& graph, OdometryMat
     : graph_(graph), config_(config) {}
 
 double OdometryMapMatcher::road_bearing_deg(EdgeId e, double offset_m) const {
-  const double len = graph_.length_m(e);
-  const maps::Point2 a = graph_.point_along(e, std::clamp(offset_m - 3.0, 0.0, len));
-  const maps::Point2 b = graph_.point_along(e, std::clamp(offset_m + 3.0, 0.0, len));
-  return std::atan2(b.x_m - a.x_m, b.y_m - a.y_m) * 180.0 / std::numbers::pi;
+  return localizer::road_bearing_deg(graph_, e, offset_m, 3.0);
 }
 
 void OdometryMapMatcher::start(EdgeId edge, double offset_m, double heading_deg, double time_s, double sigma_m) {

@@ -1,5 +1,7 @@
 #include "localizer/match/hmm_matcher.hpp"
 
+#include "localizer/match/bearing.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -9,18 +11,6 @@ namespace corridor::localizer {
 namespace {
 
 constexpr double kNoScore = -std::numeric_limits<double>::infinity();
-
-double bearing_deg(const maps::RoadGraph& g, EdgeId e, double offset_m) {
-  const double len = g.length_m(e);
-  const maps::Point2 a = g.point_along(e, std::max(0.0, offset_m - 2.0));
-  const maps::Point2 b = g.point_along(e, std::min(len, offset_m + 2.0));
-  return std::atan2(b.x_m - a.x_m, b.y_m - a.y_m) * 180.0 / std::numbers::pi;
-}
-
-double angle_between_deg(double a, double b) {
-  const double d = std::fmod(std::abs(a - b), 360.0);
-  return d > 180.0 ? 360.0 - d : d;
-}
 
 }  // namespace
 
@@ -56,7 +46,7 @@ std::vector<HmmMatcher::Candidate> HmmMatcher::candidates_for(const GpsFix& fix,
     auto add = [&](EdgeId e, double offset) {
       double score = emission;
       if (use_heading) {
-        const double off = angle_between_deg(bearing_deg(graph_, e, offset), *fix.heading_deg) / config_.heading_sigma_deg;
+        const double off = angle_between_deg(road_bearing_deg(graph_, e, offset), *fix.heading_deg) / config_.heading_sigma_deg;
         score -= 0.5 * off * off;
       }
       out.push_back({e, offset, road.point, road.distance_m, score, -1});
@@ -237,6 +227,7 @@ std::vector<MatchedPoint> HmmMatcher::match(std::span<const GpsFix> trace) {
     }
   };
   std::size_t chain_first = 0;
+  std::size_t skipped = 0;  // fixes in a row that no candidate of the chain could reach
   for (std::size_t i = 0; i < trace.size(); ++i) {
     Step step;
     step.time_s = trace[i].time_s;
@@ -248,6 +239,14 @@ std::vector<MatchedPoint> HmmMatcher::match(std::span<const GpsFix> trace) {
       continue;  // out[i] stays unmatched
     }
     const bool linked = steps.size() > chain_first && link(steps.back(), step, trace[i], distances);
+    // A fix nothing in the chain can reach, between fixes that fit it, is an outlier (multipath):
+    // left unmatched rather than breaking the chain, at most max_skipped in a row.
+    if (!linked && steps.size() > chain_first && skipped < config_.max_skipped &&
+        trace[i].time_s - steps.back().time_s <= config_.gap_s) {
+      ++skipped;
+      continue;
+    }
+    skipped = 0;
     if (!linked) {
       finish_chain(chain_first);
       chain_first = steps.size();

@@ -34,6 +34,7 @@ struct HmmConfig {
   double heading_min_speed_mps = 2.0;  // below this the course over ground is noise
   double backward_tolerance_m = 8.0;   // noise may put a fix a little behind the last one on a road
   std::size_t window = 8;         // online: steps kept (the lag bound)
+  std::size_t max_skipped = 2;    // batch: unreachable fixes in a row skipped as outliers before a break
   // Batch: smooth each chain along its matched path (path_smoother.hpp), or leave each point
   // where its fix projects.
   enum class AlongPath { smoothed, projected } along_path = AlongPath::smoothed;

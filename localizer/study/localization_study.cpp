@@ -1,5 +1,7 @@
 #include "localizer/study/localization_study.hpp"
 
+#include "localizer/match/bearing.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -9,19 +11,6 @@
 namespace corridor::localizer {
 namespace {
 
-double wrap180(double d) {
-  d = std::fmod(d, 360.0);
-  if (d <= -180.0) d += 360.0;
-  if (d > 180.0) d -= 360.0;
-  return d;
-}
-
-double bearing_deg(const maps::RoadGraph& g, EdgeId e, double offset_m) {
-  const double len = g.length_m(e);
-  const maps::Point2 a = g.point_along(e, std::clamp(offset_m - 3.0, 0.0, len));
-  const maps::Point2 b = g.point_along(e, std::clamp(offset_m + 3.0, 0.0, len));
-  return std::atan2(b.x_m - a.x_m, b.y_m - a.y_m) * 180.0 / std::numbers::pi;
-}
 
 }  // namespace
 
@@ -32,7 +21,7 @@ EdgeId true_edge(const maps::RoadGraph& g, const maps::EdgeSnapper& snapper, map
   for (const maps::SnapResult& r : snapper.candidates_local(p, radius_m, 8)) {
     for (auto [e, off] : {std::pair{r.edge, r.offset_m}, std::pair{r.twin, r.twin_offset_m}}) {
       if (!e.valid()) continue;
-      if (std::abs(wrap180(bearing_deg(g, e, off) - heading_deg)) > 60.0) continue;
+      if (angle_between_deg(road_bearing_deg(g, e, off, 3.0), heading_deg) > 60.0) continue;
       if (r.distance_m < best_d) best = e, best_d = r.distance_m;
     }
   }
@@ -207,9 +196,10 @@ std::string drive_plot_svg(const maps::RoadGraph& g, const DrivePlot& plot, cons
   for (EdgeId e : g.edges()) {
     if (g.twin(e).valid() && g.twin(e) < e) continue;
     const auto pts = g.geometry(e);
-    bool near = false;
-    for (const auto& p : pts) near = near || (p.x_m > x0 && p.x_m < x1 && p.y_m > y0 && p.y_m < y1);
-    if (!near) continue;
+    // Drawn when its bounding box meets the plot's: a long straight road has no point inside.
+    double ex0 = 1e18, ey0 = 1e18, ex1 = -1e18, ey1 = -1e18;
+    for (const auto& p : pts) ex0 = std::min(ex0, p.x_m), ey0 = std::min(ey0, p.y_m), ex1 = std::max(ex1, p.x_m), ey1 = std::max(ey1, p.y_m);
+    if (ex1 < x0 || ex0 > x1 || ey1 < y0 || ey0 > y1) continue;
     s << "<polyline points='";
     for (const auto& p : pts) s << X(p.x_m) << ',' << Y(p.y_m) << ' ';
     s << "'/>\n";

@@ -10,6 +10,7 @@
 #include <numbers>
 #include <random>
 
+#include "localizer/match/synthetic_trace.hpp"
 #include "tests/localizer/sketch_graph.hpp"
 #include "maps/synthetic_grid.hpp"
 #include "planner/route.hpp"
@@ -192,31 +193,12 @@ TEST(HmmMatcher, RecoversTheDrivenEdgesOfRandomRoutes) {
     const auto g = maps::make_perturbed_grid(spec);
     const maps::EdgeSnapper snapper(g);
     HmmMatcher matcher(g, snapper);
-    std::mt19937_64 rng(seed);
-    std::normal_distribution<double> noise(0.0, 5.0);
-    // A random walk that never turns straight back: its edges are the truth.
-    std::vector<EdgeId> walk;
-    EdgeId e{static_cast<std::uint32_t>(rng() % g.edge_count())};
-    for (int k = 0; k < 40; ++k) {
-      walk.push_back(e);
-      std::vector<EdgeId> next;
-      for (EdgeId o : g.out_edges(g.head(e))) {
-        if (o != g.twin(e)) next.push_back(o);
-      }
-      if (next.empty()) break;
-      e = next[rng() % next.size()];
-    }
-    std::vector<GpsFix> trace;
-    std::vector<EdgeId> truth;
-    double t = 0, along = 5.0;
-    for (EdgeId w : walk) {
-      for (; along < g.length_m(w); along += 12.0, t += 1.0) {
-        const maps::Point2 p = g.point_along(w, along);
-        trace.push_back(fix_at(g, t, {p.x_m + noise(rng), p.y_m + noise(rng)}));
-        truth.push_back(w);
-      }
-      along -= g.length_m(w);
-    }
+    SyntheticTraceSpec drive;
+    drive.seed = seed;
+    drive.noise_sigma_m = 5.0;
+    const SyntheticTrace t = make_synthetic_trace(g, drive);
+    const std::vector<GpsFix>& trace = t.fixes;
+    const std::vector<EdgeId>& truth = t.truth;
     const auto matched = matcher.match(trace);
     for (std::size_t i = 0; i < trace.size(); ++i) {
       ++total;
