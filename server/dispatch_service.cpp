@@ -59,7 +59,6 @@ DispatchEvent position_event(const PositionReport& p, double now_s, MissionId mi
   return e;
 }
 
-
 }  // namespace
 
 DispatchService::DispatchService(const maps::RoadGraph& graph, DispatchConfig config, Store* store, double now_s)
@@ -124,15 +123,6 @@ std::size_t DispatchService::subscribe(Listener listener) {
 void DispatchService::unsubscribe(std::size_t id) {
   std::lock_guard lock(listeners_mutex_);
   listeners_.erase(id);
-}
-
-void DispatchService::emit(const std::string& kind, MissionId mission, const std::string& reason, double now_s) {
-  DispatchEvent event;
-  event.kind = kind;
-  event.mission = mission;
-  event.reason = reason;
-  event.time_s = now_s;
-  emit(std::move(event));
 }
 
 void DispatchService::emit(DispatchEvent event) {
@@ -238,11 +228,11 @@ MissionView DispatchService::view(const Mission& m) const {
   v.route_revision = m.revision;
   v.route_time_s = m.route_time_s;
   if (m.row.state == MissionState::active) {
-    std::shared_lock costs(overlay_mutex_);
-    v.congestion_factors.reserve(m.route.edges.size());
-    for (EdgeId e : m.route.edges) v.congestion_factors.push_back(overlay_.edge(e).congestion_factor);
-  }
-  if (m.row.state == MissionState::active) {
+    {
+      std::shared_lock costs(overlay_mutex_);
+      v.congestion_factors.reserve(m.route.edges.size());
+      for (EdgeId e : m.route.edges) v.congestion_factors.push_back(overlay_.edge(e).congestion_factor);
+    }
     std::lock_guard lock(preemption_mutex_);
     v.schedule = preemption_.schedule(m.row.id);
   } else {

@@ -115,7 +115,6 @@ class DispatchService {
   void repair_one(Mission& m, double now_s, CongestionResult& result, std::vector<std::shared_ptr<CommitTicket>>& durable);
   // Under preemption_mutex_.
   void drain_preemption_events(Staged& staged);
-  void emit(const std::string& kind, MissionId mission, const std::string& reason, double now_s);
   void emit(DispatchEvent event);
   // Under preemption_mutex_: emits signal_state when the signal's state changed since last said.
   void announce_signal_state(NodeId node, double now_s);

@@ -4,7 +4,6 @@
 
 #include <chrono>
 #include <future>
-#include <sstream>
 
 #include "maps/errors.hpp"
 #include "server/json_codec.hpp"
@@ -78,19 +77,21 @@ json roles_json(std::uint8_t roles) {
   return out;
 }
 
-std::string query_value(const std::string& target, const std::string& key) {
+// The query of a target ("/v1/x?a=1&b"): {a: "1", b: ""}; a key given twice keeps its last value.
+std::unordered_map<std::string, std::string> parse_query(const std::string& target) {
+  std::unordered_map<std::string, std::string> query;
   const auto q = target.find('?');
-  if (q == std::string::npos) return {};
-  std::size_t begin = q + 1;
-  while (begin < target.size()) {
+  if (q == std::string::npos) return query;
+  for (std::size_t begin = q + 1; begin <= target.size();) {
     const std::size_t end = std::min(target.find('&', begin), target.size());
     const std::string_view pair(target.data() + begin, end - begin);
-    if (pair.size() > key.size() && pair.substr(0, key.size()) == key && pair[key.size()] == '=') {
-      return std::string(pair.substr(key.size() + 1));
+    if (!pair.empty()) {
+      const auto eq = pair.find('=');
+      query[std::string(pair.substr(0, eq))] = eq == std::string_view::npos ? "" : std::string(pair.substr(eq + 1));
     }
     begin = end + 1;
   }
-  return {};
+  return query;
 }
 
 }  // namespace
@@ -278,7 +279,9 @@ bool Router::take_token(const std::string& key, double now_s) {
 }
 
 std::optional<Principal> Router::authorize_stream(const std::string& authorization, const std::string& target) {
-  const std::string ticket = query_value(target, "ticket");
+  const auto query = parse_query(target);
+  const auto it = query.find("ticket");
+  const std::string ticket = it == query.end() ? std::string() : it->second;
   auto who = ticket.empty() ? auth_.authenticate(authorization) : tickets_.redeem(ticket, clock_());
   if (!who || (who->roles & kRead) == 0) return std::nullopt;
   return who;
@@ -355,14 +358,7 @@ HttpResponse Router::answer(const HttpRequest& request, std::string& route_name)
     const auto q = request.target.find('?');
     const std::string path = request.target.substr(0, q);
     Match match;
-    if (q != std::string::npos) {
-      std::istringstream in(request.target.substr(q + 1));
-      std::string pair;
-      while (std::getline(in, pair, '&')) {
-        const auto eq = pair.find('=');
-        match.query[pair.substr(0, eq)] = eq == std::string::npos ? "" : pair.substr(eq + 1);
-      }
-    }
+    match.query = parse_query(request.target);
     // Outside the API: the console's files (GET and HEAD only).
     if (site_ && path.rfind("/v1/", 0) != 0 && path != "/v1" && path != "/metrics") {
       route_name = "GET /";

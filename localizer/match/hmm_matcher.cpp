@@ -75,12 +75,10 @@ bool HmmMatcher::link(const Step& prev, Step& next, const GpsFix& fix, planner::
   const double hdop = fix.hdop && std::isfinite(*fix.hdop) && *fix.hdop > 0.0 ? *fix.hdop : config_.default_hdop;
   const double beta = std::max(config_.beta_m, config_.beta_per_sigma * hdop * config_.sigma_base_m);
 
-  for (Candidate& c : next.candidates) {
-    c.parent = -1;
-    c.score = c.score;  // emission, set by candidates_for
-  }
+  // Best path score and parent per candidate, applied only if some candidate is reachable: a
+  // failed link leaves `next` as candidates_for made it, the start of a new chain.
   std::vector<double> best(next.candidates.size(), kNoScore);
-  bool any = false;
+  std::vector<std::int32_t> parent(next.candidates.size(), -1);
   for (std::size_t i = 0; i < prev.candidates.size(); ++i) {
     const Candidate& p = prev.candidates[i];
     if (p.score == kNoScore) continue;
@@ -107,19 +105,16 @@ bool HmmMatcher::link(const Step& prev, Step& next, const GpsFix& fix, planner::
       const double score = p.score + transition;
       if (score > best[j]) {
         best[j] = score;
-        next.candidates[j].parent = static_cast<std::int32_t>(i);
+        parent[j] = static_cast<std::int32_t>(i);
       }
     }
   }
+  if (std::all_of(best.begin(), best.end(), [](double b) { return b == kNoScore; })) return false;
   for (std::size_t j = 0; j < next.candidates.size(); ++j) {
-    if (best[j] == kNoScore) {
-      next.candidates[j].score = kNoScore;
-    } else {
-      next.candidates[j].score += best[j];
-      any = true;
-    }
+    Candidate& c = next.candidates[j];
+    c.parent = parent[j];
+    c.score = best[j] == kNoScore ? kNoScore : c.score + best[j];
   }
-  if (!any) return false;
   // Keep the scores near zero: only their differences matter.
   const double top = next.candidates[HmmMatcher::best(next)].score;
   for (Candidate& c : next.candidates) {
@@ -173,7 +168,7 @@ MatchedPoint HmmMatcher::update(const GpsFix& fix, planner::BoundedDistances* le
   }
   if (window_.empty() || !link(window_.back(), step, fix, *distances)) {
     // A new chain: its first step is scored by the emission alone.
-    step = Step{fix.time_s, step.raw, candidates_for(fix, step.raw), true};
+    step.chain_start = true;
     window_.clear();
   }
   window_.push_back(std::move(step));
@@ -250,7 +245,7 @@ std::vector<MatchedPoint> HmmMatcher::match(std::span<const GpsFix> trace) {
     if (!linked) {
       finish_chain(chain_first);
       chain_first = steps.size();
-      step = Step{trace[i].time_s, step.raw, candidates_for(trace[i], step.raw), true};
+      step.chain_start = true;  // scored by the emission alone
     }
     steps.push_back(std::move(step));
     fix_of.push_back(i);

@@ -29,7 +29,7 @@ std::vector<MatchedPoint> smooth_along_path(const maps::RoadGraph& g, planner::B
   for (std::size_t i = 1; i < n; ++i) {
     const MatchedPoint& a = points[i - 1];
     const MatchedPoint& b = points[i];
-    if (b.edge == path.back().edge && (b.edge == a.edge)) {
+    if (b.edge == a.edge && b.edge == path.back().edge) {
       s[i] = path.back().s_start + b.offset_m;  // along the same edge (a little back is noise)
       continue;
     }
