@@ -15,6 +15,7 @@
 #include "app/map_options.hpp"
 #include "app/vo_command.hpp"
 #include "localizer/fusion/gps_odometry_localizer.hpp"
+#include "localizer/fusion/simulated_odometry.hpp"
 #include "localizer/match/trace_io.hpp"
 #include "localizer/study/localization_study.hpp"
 #include "sim/corridor_client.hpp"
@@ -133,14 +134,10 @@ void run_localize(const LocalizeOptions& o) {
       odometry.push_back({static_cast<double>(i) / rate, step.translation().norm(), yaw_deg});
     }
   } else {
-    std::mt19937_64 rng(o.seed + 1);
-    std::normal_distribution<double> gauss(0.0, 1.0);
-    const double scale = 1.0 + 0.0062 * gauss(rng);
+    localizer::SimulatedOdometry simulated({}, o.seed + 1);
     for (std::size_t i = 1; i < truth.size(); ++i) {
-      const double d = maps::distance_m(truth[i - 1].position, truth[i].position);
-      double turn = std::fmod(truth[i].heading_deg - truth[i - 1].heading_deg + 540.0, 360.0) - 180.0;
-      turn += 0.24 * d / 100.0 * gauss(rng);
-      odometry.push_back({truth[i].time_s, d * scale, turn});
+      odometry.push_back(simulated.step(truth[i].time_s, truth[i - 1].position, truth[i - 1].heading_deg,
+                                        truth[i].position, truth[i].heading_deg));
     }
   }
 

@@ -11,6 +11,7 @@
 #include <random>
 
 #include "localizer/fusion/gps_odometry_localizer.hpp"
+#include "localizer/fusion/simulated_odometry.hpp"
 #include "sim/closed_loop_run.hpp"
 #include "sim/corridor_client.hpp"
 
@@ -81,7 +82,7 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
   localizer::GpsOdometryLocalizer onboard(g, snapper);
   std::mt19937_64 rng(config.seed * 7919 + 3);
   std::normal_distribution<double> gauss(0.0, 1.0);
-  const double odometry_scale = 1.0 + 0.0062 * gauss(rng);  // docs/experiments/vo.md: t_err 0.62 %
+  localizer::SimulatedOdometry odometry({}, config.seed * 7919 + 5);
   std::optional<std::pair<maps::Point2, double>> last_truth;  // position, angle
   double last_fix_s = -1e9;
   std::optional<std::uint64_t> mission;
@@ -178,11 +179,7 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
           // The receiver and the onboard localizer: odometry every step, a fix at the GPS rate.
           const maps::Point2 truth{pos->x, pos->y};
           const double angle = as_double(ev, libsumo::VAR_ANGLE);
-          if (last_truth) {
-            const double d = maps::distance_m(last_truth->first, truth);
-            const double turn = std::fmod(angle - last_truth->second + 540.0, 360.0) - 180.0 + 0.24 * d / 100.0 * gauss(rng);
-            onboard.on_odometry({t, d * odometry_scale, turn});
-          }
+          if (last_truth) onboard.on_odometry(odometry.step(t, last_truth->first, last_truth->second, truth, angle));
           last_truth = {truth, angle};
           const double since = t - ev_depart;
           const bool out = std::any_of(config.gps_outages.begin(), config.gps_outages.end(),

@@ -51,7 +51,7 @@ StudyResult run_localization_study(const maps::RoadGraph& g, const maps::EdgeSna
     const double t0 = samples.front().time_s, t1 = samples.back().time_s;
     const double outage_begin = t0 + config.outage_at * (t1 - t0);
     const double outage_end = config.outage_s > 0.0 ? outage_begin + config.outage_s : outage_begin;
-    const double scale_error = config.odometry_scale_sigma * gauss(rng);
+    SimulatedOdometry odometry(config.odometry, drive_seed * 7919 + 11);
 
     // Truth in the local frame, the GPS trace (outage dropped), and the odometry increments.
     std::vector<maps::Point2> truth(samples.size());
@@ -91,10 +91,8 @@ StudyResult run_localization_study(const maps::RoadGraph& g, const maps::EdgeSna
     maps::Point2 before_handback{};
     for (std::size_t i = 0; i < samples.size(); ++i) {
       if (i > 0) {
-        const double dist = maps::distance_m(truth[i - 1], truth[i]) * (1.0 + scale_error);
-        const double turn = wrap180(samples[i].heading_deg - samples[i - 1].heading_deg) +
-                            config.odometry_heading_deg_per_100m * dist / 100.0 * gauss(rng);
-        fusion.on_odometry({samples[i].time_s, dist, turn});
+        fusion.on_odometry(odometry.step(samples[i].time_s, truth[i - 1], samples[i - 1].heading_deg, truth[i],
+                                         samples[i].heading_deg));
       }
       const bool out_now = samples[i].time_s >= outage_begin && samples[i].time_s < outage_end;
       if (was_out && !out_now) before_handback = fusion.last().match.point;

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "localizer/fusion/gps_odometry_localizer.hpp"
+#include "localizer/fusion/simulated_odometry.hpp"
 #include "localizer/match/fcd_trace.hpp"
 
 namespace corridor::localizer {
@@ -20,8 +21,7 @@ struct StudyConfig {
   double outlier_share = 0.02;      // multipath: fixes thrown 40–100 m
   double outage_s = 60.0;           // one GPS outage per drive (0: none)...
   double outage_at = 0.4;           // ...starting this far into the drive
-  double odometry_scale_sigma = 0.0062;   // VO translation error, per drive (0.62 %, docs/experiments/vo.md)
-  double odometry_heading_deg_per_100m = 0.24;  // VO rotation error
+  VoDriftModel odometry;
   double truth_radius_m = 20.0;     // the true edge is searched this close to the true position
   std::uint64_t seed = 1;
   LocalizerConfig localizer;
