@@ -110,6 +110,9 @@ void visit_arrays(Visitor&& v, auto& d) {
   v(d.geometry);
   v(d.first_in);
   v(d.in_edge);
+  v(d.landmarks.nodes);
+  v(d.landmarks.from_ticks);
+  v(d.landmarks.to_ticks);
 }
 
 }  // namespace

@@ -10,7 +10,7 @@
 
 namespace corridor::maps {
 
-inline constexpr std::uint32_t kGraphCacheVersion = 2;  // 2: street names and refs
+inline constexpr std::uint32_t kGraphCacheVersion = 3;  // 2: street names and refs; 3: ALT landmarks
 
 struct CacheSource {
   std::uint64_t size_bytes = 0;

@@ -49,6 +49,10 @@ void validate(const RoadGraphData& d) {
               "edge head disagrees with the reverse CSR");
     }
   }
+  const std::size_t k = d.landmarks.nodes.size();
+  require(k <= 256 && d.landmarks.from_ticks.size() == n * k && d.landmarks.to_ticks.size() == n * k,
+          "landmark tables have the wrong size");
+  for (NodeId l : d.landmarks.nodes) require(l.index() < n, "landmark out of range");
   for (std::size_t e = 0; e < m; ++e) {
     require(d.edge_head[e].index() < n, "edge head out of range");
     require(std::isfinite(d.edge_length_m[e]) && d.edge_length_m[e] > 0.0, "edge length must be positive");
@@ -75,13 +79,7 @@ RoadGraph::RoadGraph(RoadGraphData data) : data_(std::move(data)), projection_(d
   if (data_.edge_ref.empty()) data_.edge_ref.assign(data_.edge_head.size(), 0);
   if (data_.strings.first.empty()) data_.strings.first = {0, 0};
   validate(data_);
-  double scale = 1.0;
-  for (std::size_t e = 0; e < edge_count(); ++e) {
-    const double chord = distance_m(position(data_.edge_tail[e]), position(data_.edge_head[e]));
-    if (chord > 0.0) scale = std::min(scale, data_.edge_length_m[e] / chord);
-  }
-  // A hair below the true ratio so that rounding in the length sums can never make h inconsistent.
-  heuristic_scale_ = scale * (1.0 - 1e-9);
+  if (data_.landmarks.nodes.empty()) data_.landmarks = compute_landmarks(data_);
 
   if (node_count() > 0) {
     min_corner_ = max_corner_ = position(NodeId{0});

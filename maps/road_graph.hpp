@@ -9,6 +9,7 @@
 
 #include "maps/geo.hpp"
 #include "maps/ids.hpp"
+#include "maps/landmarks.hpp"
 #include "maps/road_class.hpp"
 #include "maps/string_table.hpp"
 
@@ -46,6 +47,9 @@ struct RoadGraphData {
   // Reverse CSR: the in-edges of node v are in_edge[first_in[v] .. first_in[v+1]).
   std::vector<std::uint32_t> first_in;
   std::vector<EdgeId> in_edge;
+
+  // ALT landmark tables (maps/landmarks.hpp). Left empty by builders; RoadGraph computes them.
+  LandmarkTables landmarks;
 };
 
 class RoadGraph {
@@ -90,10 +94,19 @@ class RoadGraph {
   [[nodiscard]] const LocalProjection& projection() const { return projection_; }
   [[nodiscard]] const RoadGraphData& data() const { return data_; }
 
-  // Lower bound of length / straight-line distance over all edges, at most 1. Scaling the
-  // straight-line heuristic by it keeps A* and D* Lite admissible even where an edge's stated length
-  // is shorter than the chord between its end nodes (SUMO nets).
-  [[nodiscard]] double heuristic_scale() const { return heuristic_scale_; }
+  // ALT: a lower bound in seconds on the free-flow travel time from a to b, exactly consistent
+  // (maps/landmarks.hpp). Every travel cost the planner charges is at least free flow.
+  [[nodiscard]] std::size_t landmark_count() const { return data_.landmarks.nodes.size(); }
+  [[nodiscard]] std::span<const std::uint32_t> landmarks_from(NodeId v) const {
+    return {data_.landmarks.from_ticks.data() + v.index() * landmark_count(), landmark_count()};
+  }
+  [[nodiscard]] std::span<const std::uint32_t> landmarks_to(NodeId v) const {
+    return {data_.landmarks.to_ticks.data() + v.index() * landmark_count(), landmark_count()};
+  }
+  [[nodiscard]] double landmark_bound_s(NodeId a, NodeId b) const {
+    return static_cast<double>(landmark_bound_ticks(landmarks_from(a), landmarks_to(a), landmarks_from(b), landmarks_to(b))) *
+           kLandmarkTickS;
+  }
 
   // Bounding box in the local frame.
   [[nodiscard]] Point2 min_corner() const { return min_corner_; }
@@ -102,7 +115,6 @@ class RoadGraph {
  private:
   RoadGraphData data_;
   LocalProjection projection_;
-  double heuristic_scale_ = 1.0;
   Point2 min_corner_;
   Point2 max_corner_;
 };

@@ -9,8 +9,7 @@ DStarLite::DStarLite(const TravelCost& cost, std::vector<EdgePoint> starts, std:
     : space_(cost, std::move(starts), std::move(goals)),
       g_(space_.vertex_count(), kInfCost),
       rhs_(space_.vertex_count(), kInfCost),
-      open_(space_.vertex_count()),
-      last_start_pos_(space_.position(space_.start())) {
+      open_(space_.vertex_count()) {
   // Initialize(): the search runs backward, so it starts at the goal. (Koenig & Likhachev Fig. 4)
   const Vertex goal = space_.goal();
   rhs_[goal.index()] = 0.0;
@@ -19,10 +18,7 @@ DStarLite::DStarLite(const TravelCost& cost, std::vector<EdgePoint> starts, std:
 
 DStarLite::Key DStarLite::calculate_key(Vertex s) const {
   const double m = std::min(g_[s.index()], rhs_[s.index()]);
-  // last_start_pos_ is the start's position (move_start keeps it so): h(start, s) without the
-  // start's lookup, and 0 for the start itself, which the stopping test asks for every iteration.
-  const double h = s == space_.start() ? 0.0 : space_.cost().heuristic_s(last_start_pos_, space_.position(s));
-  return {add_cost(add_cost(m, h), km_), m};
+  return {add_cost(add_cost(m, space_.h_from_start_s(s)), km_), m};
 }
 
 double DStarLite::min_successor_cost(Vertex u) const {
@@ -46,11 +42,10 @@ void DStarLite::recompute_rhs(Vertex u) {
 }
 
 void DStarLite::move_start(std::vector<EdgePoint> starts) {
+  const std::vector<NodeId> old_heads(space_.start_heads().begin(), space_.start_heads().end());
   space_.set_starts(std::move(starts));
   // km grows by h(s_last, s_start) so that keys already queued stay lower bounds (paper line 38'').
-  const maps::Point2 now = space_.position(space_.start());
-  km_ = add_cost(km_, space_.cost().heuristic_s(last_start_pos_, now));
-  last_start_pos_ = now;
+  km_ = add_cost(km_, space_.start_shift_s(old_heads));
   recompute_rhs(space_.start());
 }
 

@@ -64,7 +64,6 @@ class DStarLite {
   std::vector<double> rhs_;
   IndexedHeap<Key> open_;
   double km_ = 0.0;
-  maps::Point2 last_start_pos_;
 };
 
 }  // namespace corridor::planner

@@ -34,7 +34,7 @@ Route OneToOneSearch::run(const SearchSpace& space, bool use_heuristic, SearchSt
   const Vertex s = space.start();
   const Vertex t = space.goal();
   auto dist = [&](Vertex v) { return stamp_[v.index()] == round_ ? dist_[v.index()] : kInfCost; };
-  auto h = [&](Vertex v) { return use_heuristic ? space.heuristic_s(v, t) : 0.0; };
+  auto h = [&](Vertex v) { return use_heuristic ? space.h_to_goal_s(v) : 0.0; };
 
   using Item = std::pair<double, std::uint32_t>;  // (f, vertex), lazy deletion
   std::priority_queue<Item, std::vector<Item>, std::greater<>> open;

@@ -20,7 +20,7 @@ struct SearchStats {
 
 class OneToOneSearch {
  public:
-  // Dijkstra when use_heuristic is false, A* with the straight-line heuristic otherwise.
+  // Dijkstra when use_heuristic is false, A* with the landmark (ALT) heuristic otherwise.
   Route run(const SearchSpace& space, bool use_heuristic, SearchStats* stats = nullptr);
 
  private:

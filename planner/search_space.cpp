@@ -11,14 +11,29 @@ SearchSpace::SearchSpace(const TravelCost& cost, std::vector<EdgePoint> starts, 
     : cost_(&cost), node_count_(cost.graph().node_count()) {
   normalize(goals, "goal");
   goals_ = std::move(goals);
-  goal_pos_ = cost.graph().point_along(goals_.front().edge, goals_.front().offset_m);
+  for (const EdgePoint& t : goals_) goal_tails_.push_back(cost.graph().tail(t.edge));
+  std::sort(goal_tails_.begin(), goal_tails_.end());
+  goal_tails_.erase(std::unique(goal_tails_.begin(), goal_tails_.end()), goal_tails_.end());
   set_starts(std::move(starts));
 }
 
 void SearchSpace::set_starts(std::vector<EdgePoint> starts) {
   normalize(starts, "start");
   starts_ = std::move(starts);
-  start_pos_ = cost_->graph().point_along(starts_.front().edge, starts_.front().offset_m);
+  start_heads_.clear();
+  for (const EdgePoint& s : starts_) start_heads_.push_back(cost_->graph().head(s.edge));
+  std::sort(start_heads_.begin(), start_heads_.end());
+  start_heads_.erase(std::unique(start_heads_.begin(), start_heads_.end()), start_heads_.end());
+}
+
+double SearchSpace::start_shift_s(std::span<const NodeId> old_heads) const {
+  double shift = 0.0;
+  for (NodeId b : start_heads_) {
+    double nearest = kInfCost;
+    for (NodeId a : old_heads) nearest = std::min(nearest, cost_->lower_bound_s(a, b));
+    shift = std::max(shift, nearest);
+  }
+  return shift;
 }
 
 Route SearchSpace::route_along(std::vector<EdgeId> edges) const {

@@ -3,6 +3,7 @@
 // the three use one cost model and can serve as each other's oracles.
 #pragma once
 
+#include <algorithm>
 #include <span>
 #include <vector>
 
@@ -32,11 +33,31 @@ class SearchSpace {
   [[nodiscard]] std::span<const EdgePoint> goals() const { return goals_; }
   void set_starts(std::vector<EdgePoint> starts);
 
-  [[nodiscard]] maps::Point2 position(Vertex v) const {
-    if (is_node(v)) return cost_->graph().position(node(v));
-    return v == start() ? start_pos_ : goal_pos_;
+  // The road nodes S's arcs lead to and G's arcs come from.
+  [[nodiscard]] std::span<const NodeId> start_heads() const { return start_heads_; }
+  [[nodiscard]] std::span<const NodeId> goal_tails() const { return goal_tails_; }
+
+  // Consistent lower bounds on the cost from S to v (D* Lite's backward search) and from v to G
+  // (A*'s forward search). Every path from S leaves through a start head, every path to G arrives
+  // through a goal tail, and the arcs from S and to G cost at least 0, so the minimum of the
+  // landmark bound over those nodes is admissible; a minimum of consistent bounds is consistent.
+  [[nodiscard]] double h_from_start_s(Vertex v) const {
+    if (!is_node(v)) return 0.0;
+    double best = kInfCost;
+    for (NodeId a : start_heads_) best = std::min(best, cost_->lower_bound_s(a, node(v)));
+    return best;
   }
-  [[nodiscard]] double heuristic_s(Vertex a, Vertex b) const { return cost_->heuristic_s(position(a), position(b)); }
+  [[nodiscard]] double h_to_goal_s(Vertex v) const {
+    if (!is_node(v)) return 0.0;
+    double best = kInfCost;
+    for (NodeId b : goal_tails_) best = std::min(best, cost_->lower_bound_s(node(v), b));
+    return best;
+  }
+  // How much h_from_start_s can fall, at any vertex, when the start moves from `old_heads` to the
+  // current ones: max over new heads b of min over old heads a of bound(a, b). D* Lite adds it to
+  // its key modifier km, which keeps queued keys lower bounds (the landmark bound obeys the triangle
+  // inequality; see docs/routing.md).
+  [[nodiscard]] double start_shift_s(std::span<const NodeId> old_heads) const;
   [[nodiscard]] const TravelCost& cost() const { return *cost_; }
 
   // f(Vertex to, double cost_s, EdgeId via) for every arc out of u. `via` is the road edge the arc
@@ -101,8 +122,8 @@ class SearchSpace {
   std::size_t node_count_;
   std::vector<EdgePoint> starts_;
   std::vector<EdgePoint> goals_;
-  maps::Point2 start_pos_;
-  maps::Point2 goal_pos_;
+  std::vector<NodeId> start_heads_;
+  std::vector<NodeId> goal_tails_;
 };
 
 }  // namespace corridor::planner

@@ -6,7 +6,7 @@
 namespace corridor::planner {
 
 TravelCost::TravelCost(const maps::RoadGraph& graph, const CostOverlay& overlay, VehicleProfile vehicle)
-    : graph_(&graph), overlay_(&overlay), vmax_mps_(vehicle.vmax_mps), heuristic_scale_(graph.heuristic_scale()) {
+    : graph_(&graph), overlay_(&overlay), vmax_mps_(vehicle.vmax_mps) {
   if (!(vehicle.vmax_mps > 0.0) || !std::isfinite(vehicle.vmax_mps)) {
     throw CostUpdateError("vehicle max speed must be a positive number, got " + std::to_string(vehicle.vmax_mps) +
                           " m/s");

@@ -1,5 +1,5 @@
 // The planner's cost model: edge travel time from length, speed, vehicle max speed, congestion and
-// queue delay; node crossing delay; and the admissible straight-line heuristic.
+// queue delay; node crossing delay; and the admissible landmark (ALT) heuristic.
 #pragma once
 
 #include <algorithm>
@@ -25,12 +25,13 @@ class TravelCost {
   // Throws CostUpdateError when vmax is not a positive finite speed.
   TravelCost(const maps::RoadGraph& graph, const CostOverlay& overlay, VehicleProfile vehicle);
 
-  // length / min(edge speed, vmax) × congestion factor, but never faster than vmax allows: a factor
-  // below 1 cannot make the vehicle outrun itself, which keeps the heuristic admissible.
+  // length / min(edge speed, vmax) × congestion factor, and never below that free-flow time:
+  // congestion only slows a vehicle down. A factor below 1 (traffic measured faster than the legal
+  // speed) counts as 1, which keeps free flow at the legal speed a lower bound of every edge's
+  // cost, as the landmark heuristic requires.
   [[nodiscard]] double running_time_s(EdgeId e) const {
-    const double length = graph_->length_m(e);
-    const double free_flow = length / std::min(graph_->speed_mps(e), vmax_mps_);
-    return std::max(free_flow * overlay_->edge(e).congestion_factor, length / vmax_mps_);
+    const double free_flow = graph_->length_m(e) / std::min(graph_->speed_mps(e), vmax_mps_);
+    return free_flow * std::max(overlay_->edge(e).congestion_factor, 1.0);
   }
   [[nodiscard]] double edge_time_s(EdgeId e) const { return add_cost(running_time_s(e), overlay_->edge(e).queue_delay_s); }
   [[nodiscard]] double node_delay_s(NodeId v) const { return overlay_->node_delay_s(v); }
@@ -45,9 +46,9 @@ class TravelCost {
   // would charge a vehicle at the stop line for a queue it is already through.
   [[nodiscard]] double partial_time_s(EdgeId e, double from_m, double to_m) const;
 
-  [[nodiscard]] double heuristic_s(maps::Point2 a, maps::Point2 b) const {
-    return maps::distance_m(a, b) * heuristic_scale_ / vmax_mps_;
-  }
+  // A lower bound on the cost of any path from a to b, consistent over every arc: the graph's
+  // landmark bound on free-flow time (maps/landmarks.hpp).
+  [[nodiscard]] double lower_bound_s(NodeId a, NodeId b) const { return graph_->landmark_bound_s(a, b); }
 
   [[nodiscard]] const maps::RoadGraph& graph() const { return *graph_; }
   [[nodiscard]] const CostOverlay& overlay() const { return *overlay_; }
@@ -57,7 +58,6 @@ class TravelCost {
   const maps::RoadGraph* graph_;
   const CostOverlay* overlay_;
   double vmax_mps_;
-  double heuristic_scale_;
 };
 
 }  // namespace corridor::planner

@@ -28,12 +28,14 @@ TEST(TravelCost, CongestionFactorAndQueueDelay) {
   EXPECT_DOUBLE_EQ(cost.edge_time_s(ab), 37.0);
 }
 
-TEST(TravelCost, FactorBelowOneNeverBeatsVehicleMaxSpeed) {
+TEST(TravelCost, FactorBelowOneNeverBeatsFreeFlow) {
   const auto g = diamond();
   CostOverlay overlay(g);
   const EdgeId ab = edge_from_to(g, 1, 2);
   overlay.set_edge(ab, {0.1, 0.0});
-  EXPECT_DOUBLE_EQ(TravelCost(g, overlay, {20.0}).running_time_s(ab), 5.0);  // 100 m at vmax 20 m/s
+  // 100 m: at the edge's legal speed when the vehicle may go faster, at vmax when it may not.
+  EXPECT_DOUBLE_EQ(TravelCost(g, overlay, {50.0}).running_time_s(ab), 100.0 / g.speed_mps(ab));
+  EXPECT_DOUBLE_EQ(TravelCost(g, overlay, {5.0}).running_time_s(ab), 20.0);
 }
 
 TEST(TravelCost, ClosedEdgeIsInfinite) {
@@ -68,14 +70,15 @@ TEST(TravelCost, TransitAddsTheTailIntersectionDelay) {
   EXPECT_DOUBLE_EQ(cost.transit_s(edge_from_to(g, 1, 2)), 10.0);
 }
 
-TEST(TravelCost, HeuristicIsStraightLineAtVehicleMaxSpeed) {
+TEST(TravelCost, LowerBoundNeverExceedsAnEdgesCost) {
   const auto g = diamond();
-  const CostOverlay overlay(g);
-  const TravelCost cost(g, overlay, {25.0});
-  EXPECT_NEAR(cost.heuristic_s({0, 0}, {300, 400}), 20.0, 1e-6);
-  // Admissible on every edge: never more than the edge's cheapest possible time.
-  for (EdgeId e : g.edges()) {
-    EXPECT_LE(cost.heuristic_s(g.position(g.tail(e)), g.position(g.head(e))), g.length_m(e) / 25.0);
+  CostOverlay overlay(g);
+  overlay.set_edge(edge_from_to(g, 1, 2), {0.2, 0.0});  // "faster than free flow" must not break it
+  for (const double vmax : {5.0, 25.0, 80.0}) {
+    const TravelCost cost(g, overlay, {vmax});
+    for (EdgeId e : g.edges()) {
+      EXPECT_LE(cost.lower_bound_s(g.tail(e), g.head(e)), cost.transit_s(e));
+    }
   }
 }
 
