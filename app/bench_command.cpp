@@ -3,6 +3,7 @@
 #include "app/match_command.hpp"
 
 #include <cmath>
+#include <fstream>
 #include <iostream>
 #include <memory>
 
@@ -19,6 +20,7 @@ struct ReplanOptions {
   MapOptions map;
   bench::ReplanBenchConfig config;
   std::uint32_t synthetic_grid_nodes = 0;
+  std::string samples_csv;
 };
 
 void run_replan(const ReplanOptions& o) {
@@ -26,17 +28,26 @@ void run_replan(const ReplanOptions& o) {
   if (o.config.updates_per_batch == 0) throw UsageError("--updates must be at least 1");
   if (!(o.config.vmax_kmh > 0 && o.config.vmax_kmh <= 400)) throw UsageError("--vmax-kmh must be in (0, 400]");
   nlohmann::json out;
+  std::ofstream samples;
+  if (!o.samples_csv.empty()) {
+    samples.open(o.samples_csv);
+    if (!samples) throw UsageError("cannot write --samples-csv '" + o.samples_csv + "'");
+  }
+  auto finish = [&](const bench::ReplanBenchResult& r) {
+    if (samples.is_open()) bench::write_samples_csv(samples, r.samples);
+    return bench::to_json(r, o.config);
+  };
   if (o.synthetic_grid_nodes > 0) {
     if (!o.map.map_file.empty()) throw UsageError("give either --map or --synthetic-grid, not both");
     maps::GridSpec spec;
     spec.rows = spec.cols = static_cast<std::uint32_t>(std::ceil(std::sqrt(o.synthetic_grid_nodes)));
     spec.seed = o.config.seed;
     const maps::RoadGraph graph = maps::make_perturbed_grid(spec);
-    out = bench::to_json(bench::run_replan_bench(graph, o.config), o.config);
+    out = finish(bench::run_replan_bench(graph, o.config));
     out["map"] = "synthetic perturbed grid " + std::to_string(spec.rows) + "x" + std::to_string(spec.cols);
   } else {
     const maps::RoadGraph graph = load_map_from_options(o.map);
-    out = bench::to_json(bench::run_replan_bench(graph, o.config), o.config);
+    out = finish(bench::run_replan_bench(graph, o.config));
     out["map"] = o.map.map_file.empty() ? "embedded monaco.osm.gz" : o.map.map_file;
   }
   std::cout << out.dump(2) << '\n';
@@ -65,6 +76,7 @@ void register_bench_command(CLI::App& app) {
   replan->add_option("--clearing", o->config.clearing_fraction, "share that clear congestion (cost decreases)")
       ->capture_default_str();
   replan->add_option("--min-trip-m", o->config.min_trip_m, "minimum straight-line trip length (0 = auto)");
+  replan->add_option("--samples-csv", o->samples_csv, "also write one CSV row per replan (times, expansions)");
   replan->add_flag("!--no-dijkstra", o->config.run_dijkstra, "skip the Dijkstra baseline (and the mismatch check)");
   replan->callback([o] { run_replan(*o); });
 

@@ -4,6 +4,8 @@
 #pragma once
 
 #include <cstdint>
+#include <ostream>
+#include <vector>
 #include <nlohmann/json.hpp>
 
 #include "maps/road_graph.hpp"
@@ -40,9 +42,24 @@ struct LatencySummary {
 LatencySummary summarize_ms(std::vector<double> samples_ms);
 nlohmann::json to_json(const LatencySummary& s);
 
+// One replan, for finding where the tail's time goes (`--samples-csv`).
+struct ReplanSample {
+  std::uint32_t trip = 0;
+  std::uint32_t step = 0;
+  double dstar_ms = 0;
+  double astar_ms = 0;
+  double dijkstra_ms = 0;
+  std::uint64_t dstar_expanded = 0;
+  std::uint64_t dstar_raised = 0;
+  std::uint64_t astar_settled = 0;
+  std::size_t route_edges_before = 0;
+  bool reachable = true;
+};
+
 struct ReplanBenchResult {
   std::size_t nodes = 0;
   std::size_t edges = 0;
+  std::size_t landmarks = 0;
   std::size_t trips = 0;
   std::size_t replans = 0;
   std::size_t mismatches = 0;  // |D* Lite − Dijkstra| > 1e-9 relative
@@ -55,7 +72,11 @@ struct ReplanBenchResult {
   double dstar_mean_raised = 0;
   double astar_mean_settled = 0;
   double dijkstra_mean_settled = 0;
+  std::vector<ReplanSample> samples;
 };
+
+// trip,step,dstar_ms,astar_ms,dijkstra_ms,dstar_expanded,dstar_raised,astar_settled,route_edges_before,reachable
+void write_samples_csv(std::ostream& out, const std::vector<ReplanSample>& samples);
 
 // Throws std::invalid_argument for a config that cannot run (no trips, negative fractions, ...).
 ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBenchConfig& config);

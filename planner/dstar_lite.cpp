@@ -78,6 +78,16 @@ ReplanStats DStarLite::replan() {
     const double slack = 1e-9 * std::max(1.0, std::abs(ks.k1));
     return open_.top_key().k1 <= ks.k1 + slack || rhs_[start.index()] > g_[start.index()];
   };
+  // A start whose every arc is closed reaches nothing, and a goal whose every arc is closed is
+  // reached from nowhere, whatever the g values. The loop would settle the whole old search tree to
+  // prove it (S's key is infinite); stop at once instead. The queue keeps its entries, so the next
+  // replan carries on from a state that is still D* Lite's.
+  bool start_cut_off = true;
+  space_.for_each_successor(start, [&](Vertex, double c, EdgeId) { start_cut_off = start_cut_off && c >= kInfCost; });
+  bool goal_cut_off = true;
+  space_.for_each_predecessor(goal, [&](Vertex, double c) { goal_cut_off = goal_cut_off && c >= kInfCost; });
+  cut_off_ = start_cut_off || goal_cut_off;
+  if (cut_off_) return stats;
   while (!open_.empty() && must_continue()) {
     const Vertex u{open_.top()};
     const Key k_old = open_.top_key();
@@ -140,7 +150,7 @@ std::string DStarLite::invariant_violation() const {
 Route DStarLite::route() const {
   const Vertex start = space_.start();
   const Vertex goal = space_.goal();
-  if (rhs_[start.index()] >= kInfCost) return space_.route_along({});
+  if (cost_to_goal_s() >= kInfCost) return space_.route_along({});
   std::vector<EdgeId> edges;
   Vertex u = start;
   // Every arc costs more than zero except S arcs, so a path has at most vertex_count arcs.

@@ -37,7 +37,7 @@ class DStarLite {
 
   // Cost from the vehicle to the goal (kInfCost when unreachable); valid after replan().
   // rhs, not g: S has no predecessors, so the search may stop with S overconsistent.
-  [[nodiscard]] double cost_to_goal_s() const { return rhs_[space_.start().index()]; }
+  [[nodiscard]] double cost_to_goal_s() const { return cut_off_ ? kInfCost : rhs_[space_.start().index()]; }
   // The current route, extracted greedily from the g values; valid after replan().
   [[nodiscard]] Route route() const;
 
@@ -64,6 +64,7 @@ class DStarLite {
   std::vector<double> rhs_;
   IndexedHeap<Key> open_;
   double km_ = 0.0;
+  bool cut_off_ = false;  // every arc out of S or into G is closed: no route, repair deferred
 };
 
 }  // namespace corridor::planner

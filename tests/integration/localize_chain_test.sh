@@ -62,17 +62,20 @@ check "the mission completed at the destination" "[[ '$completed' == 'True' ]]"
 state=$(curl -s "$url/v1/missions/$mission" -H "Authorization: Bearer $TOKEN" | python3 -c "import json,sys; print(json.load(sys.stdin)['state'])")
 check "mission state is completed ($state)" "[[ '$state' == completed ]]"
 
-# 5. The server followed the odometry: source "vo" positions stored against the mission, and
-#    followed (each moved the mission's D* Lite start).
+# 5. The server followed the odometry: source "vo" positions stored against the mission, every one
+#    followed (each moved the mission's D* Lite start). The drive may pass its own end point before
+#    it finishes, which completes the mission there; later positions belong to no mission.
 kill "$server_pid"; wait "$server_pid" 2> /dev/null; server_pid=""
-vo_followed=$(python3 - "$work/corridor.db" "$mission" << 'PY'
+read -r vo_with_mission vo_followed <<< "$(python3 - "$work/corridor.db" "$mission" << 'PY'
 import sqlite3, sys
 db = sqlite3.connect(sys.argv[1])
-print(db.execute("SELECT COUNT(*) FROM positions WHERE mission_id=? AND source='vo' AND disposition='followed'",
-                 (int(sys.argv[2]),)).fetchone()[0])
+q = "SELECT COUNT(*), SUM(disposition='followed') FROM positions WHERE mission_id=? AND source='vo'"
+n, followed = db.execute(q, (int(sys.argv[2]),)).fetchone()
+print(n, followed or 0)
 PY
-)
-check "source vo positions were followed for the mission ($vo_followed)" "[[ ${vo_followed:-0} -ge 40 ]]"
+)"
+check "source vo positions were stored for the mission ($vo_with_mission)" "[[ ${vo_with_mission:-0} -ge 20 ]]"
+check "every one of them was followed ($vo_followed of $vo_with_mission)" "[[ '${vo_followed:-0}' == '${vo_with_mission:-x}' ]]"
 
 echo "$passed passed, $failed failed"
 ((failed == 0))
