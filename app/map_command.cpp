@@ -46,6 +46,7 @@ void run_import(const ImportOptions& o) {
   j["osm_ways_read"] = report.osm_ways_read;
   j["osm_ways_kept"] = report.osm_ways_kept;
   j["osm_signal_nodes"] = report.osm_signal_nodes;
+  j["osm_barrier_nodes"] = report.osm_barrier_nodes;
   j["graph_nodes_before_scc"] = report.graph.input_nodes;
   j["dropped_nodes_outside_largest_scc"] = report.graph.dropped_nodes;
   j["strongly_connected_components"] = report.graph.components;

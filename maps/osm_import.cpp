@@ -36,7 +36,20 @@ std::string_view tag(const osmium::TagList& tags, const char* key) {
 class RoadCollector : public osmium::handler::Handler {
  public:
   void node(const osmium::Node& node) {
-    if (tag(node.tags(), "highway") == "traffic_signals") signals.push_back(node.id());
+    const auto& t = node.tags();
+    if (t.empty()) return;
+    if (tag(t, "highway") == "traffic_signals") signals.push_back(node.id());
+    NodeTags nt;
+    nt.barrier = tag(t, "barrier");
+    nt.bollard = tag(t, "bollard");
+    nt.kerb = tag(t, "kerb");
+    nt.maxheight = tag(t, "maxheight");
+    nt.access = tag(t, "access");
+    nt.vehicle = tag(t, "vehicle");
+    nt.motor_vehicle = tag(t, "motor_vehicle");
+    nt.motorcar = tag(t, "motorcar");
+    nt.emergency = tag(t, "emergency");
+    if (node_blocks_emergency(nt)) barriers.push_back(node.id());
   }
 
   void way(const osmium::Way& way) {
@@ -57,6 +70,18 @@ class RoadCollector : public osmium::handler::Handler {
     wt.motorcar = tag(t, "motorcar");
     wt.emergency = tag(t, "emergency");
     wt.area = tag(t, "area");
+    wt.construction = tag(t, "construction");
+    wt.oneway_motorcar = tag(t, "oneway:motorcar");
+    wt.oneway_motor_vehicle = tag(t, "oneway:motor_vehicle");
+    wt.oneway_vehicle = tag(t, "oneway:vehicle");
+    wt.motorcar_forward = tag(t, "motorcar:forward");
+    wt.motorcar_backward = tag(t, "motorcar:backward");
+    wt.motor_vehicle_forward = tag(t, "motor_vehicle:forward");
+    wt.motor_vehicle_backward = tag(t, "motor_vehicle:backward");
+    wt.vehicle_forward = tag(t, "vehicle:forward");
+    wt.vehicle_backward = tag(t, "vehicle:backward");
+    wt.access_forward = tag(t, "access:forward");
+    wt.access_backward = tag(t, "access:backward");
     const auto rules = interpret_way(wt);
     if (!rules || way.nodes().size() < 2) return;
     ways.push_back({OsmWayId{way.id()}, *rules, static_cast<std::uint32_t>(refs.size()),
@@ -73,6 +98,7 @@ class RoadCollector : public osmium::handler::Handler {
   std::vector<osmium::object_id_type> refs;
   std::vector<osmium::Location> locations;
   std::vector<osmium::object_id_type> signals;
+  std::vector<osmium::object_id_type> barriers;  // nodes an emergency vehicle cannot pass
   StringInterner strings;
 };
 
@@ -108,6 +134,7 @@ RoadGraph import_osm(const std::filesystem::path& path, const OsmImportOptions& 
   }
   RoadCollector c = read_file(path, options);
   std::sort(c.signals.begin(), c.signals.end());
+  std::sort(c.barriers.begin(), c.barriers.end());
 
   // Junctions: nodes used more than once (by several ways or twice by one) and way ends. Every
   // other node is inside a chain and only contributes geometry.
@@ -122,6 +149,9 @@ RoadGraph import_osm(const std::filesystem::path& path, const OsmImportOptions& 
     return static_cast<std::size_t>(hi - lo);
   };
   auto is_signal = [&](osmium::object_id_type id) { return std::binary_search(c.signals.begin(), c.signals.end(), id); };
+  auto is_barrier = [&](osmium::object_id_type id) {
+    return std::binary_search(c.barriers.begin(), c.barriers.end(), id);
+  };
 
   if (sorted_refs.empty()) throw MapLoadError("no drivable road in '" + path.string() + "'");
 
@@ -138,14 +168,19 @@ RoadGraph import_osm(const std::filesystem::path& path, const OsmImportOptions& 
 
   std::unordered_map<osmium::object_id_type, std::uint32_t> junction_index;
   junction_index.reserve(sorted_refs.size() / 4);
-  auto junction = [&](std::size_t ref_i) {
+  auto add_node = [&](std::size_t ref_i) {
     const auto id = c.refs[ref_i];
-    auto [it, inserted] = junction_index.try_emplace(id, static_cast<std::uint32_t>(in.node_pos.size()));
-    if (inserted) {
-      in.node_pos.push_back(projection.to_local({c.locations[ref_i].lat(), c.locations[ref_i].lon()}));
-      in.node_osm.push_back(OsmNodeId{id});
-      in.node_signalized.push_back(is_signal(id) ? 1 : 0);
-    }
+    in.node_pos.push_back(projection.to_local({c.locations[ref_i].lat(), c.locations[ref_i].lon()}));
+    in.node_osm.push_back(OsmNodeId{id});
+    in.node_signalized.push_back(is_signal(id) ? 1 : 0);
+    return static_cast<std::uint32_t>(in.node_pos.size() - 1);
+  };
+  // A barrier the vehicle cannot pass becomes a separate dead end for every road that reaches it:
+  // each side can be driven up to it (and a goal there reached), but no route passes through.
+  auto junction = [&](std::size_t ref_i) {
+    if (is_barrier(c.refs[ref_i])) return add_node(ref_i);
+    auto [it, inserted] = junction_index.try_emplace(c.refs[ref_i], 0);
+    if (inserted) it->second = add_node(ref_i);
     return it->second;
   };
 
@@ -172,7 +207,7 @@ RoadGraph import_osm(const std::filesystem::path& path, const OsmImportOptions& 
         for (std::uint32_t k = i + 1; k < run_end; ++k) {
           const Point2 p = projection.to_local({c.locations[k].lat(), c.locations[k].lon()});
           along += distance_m(in.points.back(), p);
-          const bool is_junction = k + 1 == run_end || use_count(c.refs[k]) >= 2;
+          const bool is_junction = k + 1 == run_end || use_count(c.refs[k]) >= 2 || is_barrier(c.refs[k]);
           if (!is_junction) {
             in.points.push_back(p);
             if (is_signal(c.refs[k])) interior_signals.emplace_back(k, along);
@@ -199,10 +234,11 @@ RoadGraph import_osm(const std::filesystem::path& path, const OsmImportOptions& 
             signal_marks.push_back(d <= to_end ? PendingSignal{from, d} : PendingSignal{to, to_end});
           }
           interior_signals.clear();
-          from = to;
+          // Past a barrier, the next segment starts from the barrier's other side.
+          from = is_barrier(c.refs[k]) && k + 1 < run_end ? junction(k) : to;
           along = 0.0;
           first_point = static_cast<std::uint32_t>(in.points.size());
-          in.points.push_back(in.node_pos[to]);
+          in.points.push_back(in.node_pos[from]);
         }
         in.points.pop_back();  // the run's last junction opened a segment that never came
       }
@@ -218,6 +254,7 @@ RoadGraph import_osm(const std::filesystem::path& path, const OsmImportOptions& 
   local.osm_ways_read = c.ways_read;
   local.osm_ways_kept = c.ways.size();
   local.osm_signal_nodes = c.signals.size();
+  local.osm_barrier_nodes = c.barriers.size();
   if (report != nullptr) *report = local;
   return graph;
 }

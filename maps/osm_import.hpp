@@ -20,6 +20,7 @@ struct OsmImportReport {
   std::size_t osm_ways_read = 0;
   std::size_t osm_ways_kept = 0;
   std::size_t osm_signal_nodes = 0;
+  std::size_t osm_barrier_nodes = 0;  // nodes an emergency vehicle cannot pass (split into dead ends)
   GraphBuildReport graph;
 };
 

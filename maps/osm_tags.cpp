@@ -3,6 +3,9 @@
 #include <array>
 #include <cctype>
 #include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <string>
 #include <utility>
 
@@ -109,11 +112,73 @@ OnewayRule parse_oneway(std::string_view v) {
   return OnewayRule::unspecified;
 }
 
+// A length in metres: "3.5", "3.5 m", "12'6\"" (feet and inches). nullopt for "default", "none",
+// "below_default" and anything else that carries no number.
+std::optional<double> parse_length_m(std::string_view raw) {
+  const std::string v = lower(trim(raw));
+  if (v.empty()) return std::nullopt;
+  if (const auto foot = v.find('\''); foot != std::string::npos) {
+    double feet = 0, inches = 0;
+    if (std::sscanf(v.c_str(), "%lf'%lf", &feet, &inches) >= 1 && std::isfinite(feet)) {
+      return (feet * 12.0 + (std::isfinite(inches) ? inches : 0.0)) * 0.0254;
+    }
+    return std::nullopt;
+  }
+  char* end = nullptr;
+  const double m = std::strtod(v.c_str(), &end);
+  if (end == v.c_str() || !std::isfinite(m) || m <= 0) return std::nullopt;
+  const std::string unit = lower(trim(std::string_view(end)));
+  if (unit.empty() || unit == "m") return m;
+  if (unit == "ft") return m * 0.3048;
+  return std::nullopt;
+}
+
+bool access_item_forbids(std::string_view v) {
+  return is_one_of(v, {"no", "agricultural", "forestry", "emergency_no", "use_sidepath", "discouraged", "foot",
+                       "bicycle", "horse", "restricted", "military"});
+}
+
+// A value or a ';'-separated list of them: forbids when every listed item does.
 bool access_forbids(std::string_view v) {
-  return is_one_of(v, {"no", "agricultural", "forestry", "emergency_no", "use_sidepath", "discouraged"});
+  bool any = false;
+  while (!v.empty()) {
+    const auto semi = v.find(';');
+    const std::string_view item = trim(v.substr(0, semi));
+    if (!item.empty()) {
+      if (!access_item_forbids(item)) return false;
+      any = true;
+    }
+    if (semi == std::string_view::npos) break;
+    v.remove_prefix(semi + 1);
+  }
+  return any;
+}
+
+// The most specific access tag present decides: true when it forbids.
+bool most_specific_forbids(std::initializer_list<std::string_view> most_specific_first) {
+  for (std::string_view v : most_specific_first) {
+    if (!v.empty()) return access_forbids(v);
+  }
+  return false;
 }
 
 }  // namespace
+
+bool node_blocks_emergency(const NodeTags& t, double vehicle_height_m) {
+  if (is_one_of(t.emergency, {"yes", "designated", "official", "permissive"})) return false;
+  if (t.emergency == "no") return true;
+  if (most_specific_forbids({t.motorcar, t.motor_vehicle, t.vehicle, t.access})) return true;
+  if (t.barrier.empty()) return false;
+  if (t.barrier == "bollard") return !is_one_of(t.bollard, {"rising", "removable", "retractable", "foldable", "flexible"});
+  if (t.barrier == "kerb") return !is_one_of(t.kerb, {"lowered", "flush", "no"});
+  if (t.barrier == "height_restrictor") {
+    const auto limit = parse_length_m(t.maxheight);
+    return limit.has_value() && *limit < vehicle_height_m;
+  }
+  // As OSRM's car profile: these let a car through; every other barrier stops it.
+  return !is_one_of(t.barrier, {"no", "gate", "lift_gate", "swing_gate", "sliding_gate", "toll_booth",
+                                "border_control", "cattle_grid", "entrance", "sally_port", "arch", "bump_gate"});
+}
 
 std::optional<double> parse_maxspeed_kmh(std::string_view raw) {
   std::string_view v = trim(raw);
@@ -166,15 +231,19 @@ std::optional<WayRules> interpret_way(const WayTags& t) {
   }
 
   if (!emergency_allowed) {
-    // The most specific access tag present decides.
-    for (std::string_view v : {t.motorcar, t.motor_vehicle, t.vehicle, t.access}) {
-      if (v.empty()) continue;
-      if (access_forbids(v)) return std::nullopt;
+    if (most_specific_forbids({t.motorcar, t.motor_vehicle, t.vehicle, t.access})) return std::nullopt;
+  }
+  if (!t.construction.empty() && !is_one_of(t.construction, {"no", "minor"})) return std::nullopt;
+
+  // The most specific oneway tag present decides (oneway:emergency is handled below).
+  std::string_view oneway_tag = t.oneway;
+  for (std::string_view v : {t.oneway_motorcar, t.oneway_motor_vehicle, t.oneway_vehicle}) {
+    if (!v.empty()) {
+      oneway_tag = v;
       break;
     }
   }
-
-  OnewayRule oneway = parse_oneway(t.oneway);
+  OnewayRule oneway = parse_oneway(oneway_tag);
   if (oneway == OnewayRule::unspecified) {
     const bool implied = t.junction == "roundabout" || t.junction == "circular" ||
                          rules.road_class == RoadClass::motorway;
@@ -184,6 +253,16 @@ std::optional<WayRules> interpret_way(const WayTags& t) {
   if (t.oneway_emergency == "no") oneway = OnewayRule::both;
   rules.forward = oneway != OnewayRule::backward;
   rules.backward = oneway != OnewayRule::forward;
+  if (!emergency_allowed) {
+    if (most_specific_forbids({t.motorcar_forward, t.motor_vehicle_forward, t.vehicle_forward, t.access_forward})) {
+      rules.forward = false;
+    }
+    if (most_specific_forbids(
+            {t.motorcar_backward, t.motor_vehicle_backward, t.vehicle_backward, t.access_backward})) {
+      rules.backward = false;
+    }
+  }
+  if (!rules.forward && !rules.backward) return std::nullopt;
 
   const double fallback = parse_maxspeed_kmh(t.maxspeed).value_or(default_speed_kmh(rules.road_class));
   rules.forward_speed_kmh = parse_maxspeed_kmh(t.maxspeed_forward).value_or(fallback);

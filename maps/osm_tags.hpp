@@ -24,6 +24,29 @@ struct WayTags {
   std::string_view motorcar;
   std::string_view emergency;
   std::string_view area;
+  std::string_view construction;
+  // Mode-specific oneway (oneway:motorcar, oneway:motor_vehicle, oneway:vehicle).
+  std::string_view oneway_motorcar;
+  std::string_view oneway_motor_vehicle;
+  std::string_view oneway_vehicle;
+  // Direction-specific access: *:forward and *:backward of motorcar, motor_vehicle, vehicle, access.
+  std::string_view motorcar_forward, motorcar_backward;
+  std::string_view motor_vehicle_forward, motor_vehicle_backward;
+  std::string_view vehicle_forward, vehicle_backward;
+  std::string_view access_forward, access_backward;
+};
+
+// The tags of a node that may stop a vehicle on the way through it.
+struct NodeTags {
+  std::string_view barrier;
+  std::string_view bollard;  // bollard=rising|removable|... for barrier=bollard
+  std::string_view kerb;     // kerb=lowered|flush|raised|... for barrier=kerb
+  std::string_view maxheight;
+  std::string_view access;
+  std::string_view vehicle;
+  std::string_view motor_vehicle;
+  std::string_view motorcar;
+  std::string_view emergency;
 };
 
 struct WayRules {
@@ -43,7 +66,25 @@ struct WayRules {
 //    stop an emergency vehicle.
 //  - oneway=yes|true|1 / -1|reverse / no; junction=roundabout|circular and highway=motorway imply
 //    oneway; oneway=reversible is not usable; oneway:emergency=no lifts the restriction.
+//  - Access values may be lists ("agricultural;forestry"): a list forbids when every item does.
+//    foot, bicycle, horse, restricted and military forbid as no does.
+//  - construction=* other than no/minor closes the way.
+//  - oneway:emergency, then oneway:motorcar, oneway:motor_vehicle, oneway:vehicle override oneway;
+//    *:forward / *:backward access (motorcar, motor_vehicle, vehicle, access, most specific first)
+//    closes one direction.
 std::optional<WayRules> interpret_way(const WayTags& tags);
+
+// True when an emergency vehicle cannot pass through a node, as OSRM's car profile reads barriers:
+// gate, lift_gate, swing_gate, sliding_gate, toll_booth, border_control, cattle_grid, entrance,
+// sally_port, arch and bump_gate let it through, and every other barrier stops it. Exceptions:
+//  - retractable bollards (bollard=rising|removable|retractable|foldable|flexible), which emergency
+//    services lower;
+//  - a kerb tagged kerb=lowered|flush|no;
+//  - a height_restrictor whose maxheight is at least the vehicle's height (or not given).
+// access=no (or vehicle/motor_vehicle/motorcar=no, as on ways) on a node blocks too, and
+// emergency=yes|designated on the node lets the vehicle through any of these.
+inline constexpr double kDefaultVehicleHeightM = 3.0;  // an ambulance's box body, with roof lights
+bool node_blocks_emergency(const NodeTags& tags, double vehicle_height_m = kDefaultVehicleHeightM);
 
 // A maxspeed value in km/h: plain numbers, "mph" and "knots" units, "none", "walk", and the implicit
 // country values ("DE:urban", "FR:rural", "CH:motorway", "GB:nsl_single", "DE:zone30", ...).

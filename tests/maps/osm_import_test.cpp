@@ -269,3 +269,118 @@ INSTANTIATE_TEST_SUITE_P(AllExtracts, SharedExtract,
 
 }  // namespace
 }  // namespace corridor::maps
+
+namespace corridor::maps {
+namespace {
+
+std::size_t out_degree(const RoadGraph& g, NodeId v) {
+  std::size_t n = 0;
+  for (EdgeId e : g.out_edges(v)) n += e.valid() ? 1 : 0;
+  return n;
+}
+
+std::vector<NodeId> nodes_by_osm(const RoadGraph& g, long long osm) {
+  std::vector<NodeId> out;
+  for (NodeId v : g.nodes()) {
+    if (g.osm_node(v).v == osm) out.push_back(v);
+  }
+  return out;
+}
+
+// True when the 200 m street from 1 to 3 is an edge (the detour around it is 400 m).
+bool street_passes(const RoadGraph& g) {
+  for (NodeId a : nodes_by_osm(g, 1)) {
+    for (EdgeId out : g.out_edges(a)) {
+      if (g.osm_node(g.head(out)).v == 3 && g.length_m(out) < 250.0) return true;
+    }
+  }
+  return false;
+}
+
+// A street 1-2-3 with node 2 tagged `barrier_tags`, and a detour 3-4-5-1 around it.
+RoadGraph street_with_node(std::map<std::string, std::string> barrier_tags, OsmImportReport* report = nullptr) {
+  return import_fixture({at(1, 0, 0), at(2, 100, 0, std::move(barrier_tags)), at(3, 200, 0), at(4, 200, 100),
+                         at(5, 0, 100)},
+                        {{60, {1, 2, 3}, kResidential}, {61, {3, 4, 5, 1}, kResidential}}, report);
+}
+
+TEST(OsmImport, BlockingBarrierSplitsTheStreetIntoTwoDeadEnds) {
+  OsmImportReport report;
+  const auto g = street_with_node({{"barrier", "bollard"}}, &report);
+  EXPECT_EQ(report.osm_barrier_nodes, 1u);
+  const auto copies = nodes_by_osm(g, 2);
+  ASSERT_EQ(copies.size(), 2u);  // one dead end on each side
+  std::vector<long long> reached;
+  for (NodeId b : copies) {
+    ASSERT_EQ(out_degree(g, b), 1u);
+    ASSERT_EQ(g.in_edges(b).size(), 1u);
+    const EdgeId out = *g.out_edges(b).begin();
+    reached.push_back(g.osm_node(g.head(out)).v);
+    EXPECT_NEAR(g.length_m(out), 100.0, 1.0);  // the stub is drivable up to the bollard
+  }
+  std::sort(reached.begin(), reached.end());
+  EXPECT_EQ(reached, (std::vector<long long>{1, 3}));
+  EXPECT_FALSE(street_passes(g));
+}
+
+TEST(OsmImport, PassableNodesStayInsideTheChain) {
+  for (const auto& tags : std::vector<std::map<std::string, std::string>>{
+           {{"barrier", "bollard"}, {"bollard", "rising"}},
+           {{"barrier", "gate"}},
+           {{"barrier", "lift_gate"}, {"access", "private"}},
+           {{"barrier", "block"}, {"emergency", "yes"}},
+           {{"access", "no"}, {"emergency", "yes"}},
+           {{"barrier", "height_restrictor"}, {"maxheight", "4.2"}},
+           {{"barrier", "kerb"}, {"kerb", "lowered"}}}) {
+    const auto g = street_with_node(tags);
+    EXPECT_TRUE(nodes_by_osm(g, 2).empty()) << tags.begin()->first << "=" << tags.begin()->second;
+    EXPECT_TRUE(street_passes(g));
+  }
+}
+
+TEST(OsmImport, BlockingNodeForms) {
+  for (const auto& tags : std::vector<std::map<std::string, std::string>>{
+           {{"barrier", "wall"}},
+           {{"barrier", "fence"}},
+           {{"barrier", "kerb"}},
+           {{"barrier", "height_restrictor"}, {"maxheight", "2.3"}},
+           {{"barrier", "gate"}, {"access", "no"}},
+           {{"access", "no"}},
+           {{"motor_vehicle", "no"}},
+           {{"barrier", "something_new"}}}) {
+    const auto g = street_with_node(tags);
+    EXPECT_EQ(nodes_by_osm(g, 2).size(), 2u) << tags.begin()->first << "=" << tags.begin()->second;
+    EXPECT_FALSE(street_passes(g));
+  }
+}
+
+TEST(OsmImport, BarrierAtAnIntersectionClosesItForEveryRoad) {
+  // 1-2-3 and 4-2-5 cross at a bollard; the outer ring keeps everything connected.
+  const auto g = import_fixture({at(1, 0, 100), at(2, 100, 100, {{"barrier", "bollard"}}), at(3, 200, 100),
+                                 at(4, 100, 0), at(5, 100, 200), at(6, 0, 0), at(7, 200, 0), at(8, 200, 200),
+                                 at(9, 0, 200)},
+                                {{70, {1, 2, 3}, kResidential},
+                                 {71, {4, 2, 5}, kResidential},
+                                 {72, {6, 4, 7, 3, 8, 5, 9, 1, 6}, kResidential}});
+  const auto copies = nodes_by_osm(g, 2);
+  EXPECT_EQ(copies.size(), 4u);
+  for (NodeId b : copies) EXPECT_EQ(out_degree(g, b), 1u);
+}
+
+TEST(OsmImport, ConstructionAndDirectionalAccess) {
+  const auto g = import_fixture(
+      {at(1, 0, 0), at(2, 100, 0), at(3, 200, 0), at(4, 200, 100), at(5, 0, 100)},
+      {{80, {1, 2}, {{"highway", "residential"}, {"motor_vehicle:backward", "no"}}},
+       {81, {2, 3}, {{"highway", "residential"}, {"oneway:motor_vehicle", "yes"}}},
+       {82, {3, 4, 5}, kResidential},
+       {83, {5, 1}, kResidential},
+       {84, {2, 4}, {{"highway", "residential"}, {"construction", "yes"}}}});
+  EXPECT_TRUE(edge_between(g, 1, 2).valid());
+  EXPECT_FALSE(edge_between(g, 2, 1).valid());
+  EXPECT_TRUE(edge_between(g, 2, 3).valid());
+  EXPECT_FALSE(edge_between(g, 3, 2).valid());
+  EXPECT_FALSE(edge_between(g, 2, 4).valid());
+}
+
+}  // namespace
+}  // namespace corridor::maps

@@ -166,3 +166,121 @@ TEST(WayRules, AreasAreNotRoads) {
 
 }  // namespace
 }  // namespace corridor::maps
+
+namespace corridor::maps {
+namespace {
+
+WayTags street() {
+  WayTags t;
+  t.highway = "residential";
+  return t;
+}
+
+TEST(WayRules, AccessListsForbidOnlyWhenEveryItemDoes) {
+  WayTags t = street();
+  t.access = "agricultural;forestry";
+  EXPECT_FALSE(interpret_way(t).has_value());
+  t.access = "agricultural; forestry";
+  EXPECT_FALSE(interpret_way(t).has_value());
+  t.access = "agricultural;destination";
+  EXPECT_TRUE(interpret_way(t).has_value());
+  for (const char* v : {"foot", "bicycle", "restricted", "military", "horse"}) {
+    t.access = v;
+    EXPECT_FALSE(interpret_way(t).has_value()) << v;
+  }
+  t.access = "no";
+  t.motor_vehicle = "yes";  // the more specific tag decides
+  EXPECT_TRUE(interpret_way(t).has_value());
+}
+
+TEST(WayRules, ConstructionClosesTheWay) {
+  WayTags t = street();
+  for (const char* v : {"yes", "major", "widening"}) {
+    t.construction = v;
+    EXPECT_FALSE(interpret_way(t).has_value()) << v;
+  }
+  for (const char* v : {"no", "minor"}) {
+    t.construction = v;
+    EXPECT_TRUE(interpret_way(t).has_value()) << v;
+  }
+}
+
+TEST(WayRules, ModeSpecificOnewayOverridesOneway) {
+  WayTags t = street();
+  t.oneway = "yes";
+  t.oneway_motor_vehicle = "no";
+  auto r = interpret_way(t);
+  ASSERT_TRUE(r.has_value());
+  EXPECT_TRUE(r->forward && r->backward);
+  t = street();
+  t.oneway_vehicle = "-1";
+  r = interpret_way(t);
+  ASSERT_TRUE(r.has_value());
+  EXPECT_FALSE(r->forward);
+  EXPECT_TRUE(r->backward);
+  t.oneway_motorcar = "yes";  // more specific than oneway:vehicle
+  r = interpret_way(t);
+  ASSERT_TRUE(r.has_value());
+  EXPECT_TRUE(r->forward);
+  EXPECT_FALSE(r->backward);
+  t.oneway_emergency = "no";  // the emergency exemption wins over all
+  r = interpret_way(t);
+  EXPECT_TRUE(r->forward && r->backward);
+}
+
+TEST(WayRules, DirectionalAccessClosesOneDirection) {
+  WayTags t = street();
+  t.access_forward = "no";
+  auto r = interpret_way(t);
+  ASSERT_TRUE(r.has_value());
+  EXPECT_FALSE(r->forward);
+  EXPECT_TRUE(r->backward);
+  t.motorcar_forward = "yes";  // more specific
+  r = interpret_way(t);
+  EXPECT_TRUE(r->forward);
+  t = street();
+  t.motor_vehicle_backward = "no";
+  t.motor_vehicle_forward = "no";
+  EXPECT_FALSE(interpret_way(t).has_value());
+  t.emergency = "yes";
+  EXPECT_TRUE(interpret_way(t).has_value());
+}
+
+TEST(NodeRules, BarriersAsACarProfileReadsThem) {
+  auto blocks = [](std::string_view barrier, std::string_view extra_key = {}, std::string_view extra = {}) {
+    NodeTags t;
+    t.barrier = barrier;
+    if (extra_key == "bollard") t.bollard = extra;
+    if (extra_key == "kerb") t.kerb = extra;
+    if (extra_key == "maxheight") t.maxheight = extra;
+    if (extra_key == "access") t.access = extra;
+    if (extra_key == "emergency") t.emergency = extra;
+    return node_blocks_emergency(t);
+  };
+  for (const char* b : {"bollard", "block", "wall", "fence", "chain", "kerb", "cycle_barrier", "turnstile", "unknown"}) {
+    EXPECT_TRUE(blocks(b)) << b;
+  }
+  for (const char* b : {"gate", "lift_gate", "toll_booth", "border_control", "cattle_grid", "entrance", "no", ""}) {
+    EXPECT_FALSE(blocks(b)) << b;
+  }
+  EXPECT_FALSE(blocks("bollard", "bollard", "rising"));
+  EXPECT_FALSE(blocks("bollard", "bollard", "removable"));
+  EXPECT_TRUE(blocks("bollard", "bollard", "fixed"));
+  EXPECT_FALSE(blocks("kerb", "kerb", "flush"));
+  EXPECT_TRUE(blocks("kerb", "kerb", "raised"));
+  EXPECT_TRUE(blocks("gate", "access", "no"));
+  EXPECT_FALSE(blocks("gate", "access", "private"));  // private does not stop an emergency vehicle
+  EXPECT_FALSE(blocks("block", "emergency", "yes"));
+  EXPECT_FALSE(blocks("height_restrictor"));  // no height given
+  EXPECT_TRUE(blocks("height_restrictor", "maxheight", "2.5"));
+  EXPECT_TRUE(blocks("height_restrictor", "maxheight", "9'6\""));  // 2.90 m
+  EXPECT_FALSE(blocks("height_restrictor", "maxheight", "3.2 m"));
+  EXPECT_FALSE(blocks("height_restrictor", "maxheight", "default"));
+  NodeTags t;
+  t.barrier = "height_restrictor";
+  t.maxheight = "3.2";
+  EXPECT_TRUE(node_blocks_emergency(t, 3.5));  // a fire engine
+}
+
+}  // namespace
+}  // namespace corridor::maps
