@@ -69,7 +69,8 @@ class Reader {
     const auto n = pod<std::uint64_t>();
     if (n > (bytes_.size() - pos_) / sizeof(T)) fail("array length exceeds the file");
     v.resize(n);
-    std::memcpy(v.data(), take(n * sizeof(T)), n * sizeof(T));
+    const char* src = take(n * sizeof(T));
+    if (n > 0) std::memcpy(v.data(), src, n * sizeof(T));  // an empty vector's data() may be null
   }
   [[nodiscard]] std::size_t position() const { return pos_; }
   [[noreturn]] void fail(const std::string& why) const {
