@@ -42,10 +42,10 @@ void DStarLite::recompute_rhs(Vertex u) {
 }
 
 void DStarLite::move_start(std::vector<EdgePoint> starts) {
-  const std::vector<NodeId> old_heads(space_.start_heads().begin(), space_.start_heads().end());
+  old_heads_.assign(space_.start_heads().begin(), space_.start_heads().end());
   space_.set_starts(std::move(starts));
   // km grows by h(s_last, s_start) so that keys already queued stay lower bounds (paper line 38'').
-  km_ = add_cost(km_, space_.start_shift_s(old_heads));
+  km_ = add_cost(km_, space_.start_shift_s(old_heads_));
   recompute_rhs(space_.start());
 }
 

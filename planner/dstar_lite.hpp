@@ -64,6 +64,7 @@ class DStarLite {
   std::vector<double> rhs_;
   IndexedHeap<Key> open_;
   double km_ = 0.0;
+  std::vector<NodeId> old_heads_;  // move_start's scratch: the heads before the move
   bool cut_off_ = false;  // every arc out of S or into G is closed: no route, repair deferred
 };
 

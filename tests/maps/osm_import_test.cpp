@@ -316,7 +316,7 @@ TEST(OsmImport, BlockingBarrierSplitsTheStreetIntoTwoDeadEnds) {
     ASSERT_EQ(g.in_edges(b).size(), 1u);
     const EdgeId out = *g.out_edges(b).begin();
     reached.push_back(g.osm_node(g.head(out)).v);
-    EXPECT_NEAR(g.length_m(out), 100.0, 1.0);  // the stub is drivable up to the bollard
+    EXPECT_NEAR(g.length_m(out), 100.0, 1.0);  // each side is drivable up to the bollard
   }
   std::sort(reached.begin(), reached.end());
   EXPECT_EQ(reached, (std::vector<long long>{1, 3}));

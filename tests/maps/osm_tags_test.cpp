@@ -170,14 +170,8 @@ TEST(WayRules, AreasAreNotRoads) {
 namespace corridor::maps {
 namespace {
 
-WayTags street() {
-  WayTags t;
-  t.highway = "residential";
-  return t;
-}
-
 TEST(WayRules, AccessListsForbidOnlyWhenEveryItemDoes) {
-  WayTags t = street();
+  WayTags t = road("residential");
   t.access = "agricultural;forestry";
   EXPECT_FALSE(interpret_way(t).has_value());
   t.access = "agricultural; forestry";
@@ -194,7 +188,7 @@ TEST(WayRules, AccessListsForbidOnlyWhenEveryItemDoes) {
 }
 
 TEST(WayRules, ConstructionClosesTheWay) {
-  WayTags t = street();
+  WayTags t = road("residential");
   for (const char* v : {"yes", "major", "widening"}) {
     t.construction = v;
     EXPECT_FALSE(interpret_way(t).has_value()) << v;
@@ -206,13 +200,13 @@ TEST(WayRules, ConstructionClosesTheWay) {
 }
 
 TEST(WayRules, ModeSpecificOnewayOverridesOneway) {
-  WayTags t = street();
+  WayTags t = road("residential");
   t.oneway = "yes";
   t.oneway_motor_vehicle = "no";
   auto r = interpret_way(t);
   ASSERT_TRUE(r.has_value());
   EXPECT_TRUE(r->forward && r->backward);
-  t = street();
+  t = road("residential");
   t.oneway_vehicle = "-1";
   r = interpret_way(t);
   ASSERT_TRUE(r.has_value());
@@ -229,7 +223,7 @@ TEST(WayRules, ModeSpecificOnewayOverridesOneway) {
 }
 
 TEST(WayRules, DirectionalAccessClosesOneDirection) {
-  WayTags t = street();
+  WayTags t = road("residential");
   t.access_forward = "no";
   auto r = interpret_way(t);
   ASSERT_TRUE(r.has_value());
@@ -238,7 +232,7 @@ TEST(WayRules, DirectionalAccessClosesOneDirection) {
   t.motorcar_forward = "yes";  // more specific
   r = interpret_way(t);
   EXPECT_TRUE(r->forward);
-  t = street();
+  t = road("residential");
   t.motor_vehicle_backward = "no";
   t.motor_vehicle_forward = "no";
   EXPECT_FALSE(interpret_way(t).has_value());
