@@ -10,7 +10,9 @@
 
 namespace corridor::maps {
 
-inline constexpr std::uint32_t kGraphCacheVersion = 3;  // 2: street names and refs; 3: ALT landmarks
+// Bumped whenever the importer reads OSM differently, too: a cache stays valid only for the rules
+// that built it.
+inline constexpr std::uint32_t kGraphCacheVersion = 4;  // 2: names and refs; 3: ALT landmarks; 4: barriers, access
 
 struct CacheSource {
   std::uint64_t size_bytes = 0;
