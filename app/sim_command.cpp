@@ -1,7 +1,11 @@
 #include "app/sim_command.hpp"
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <cmath>
+#include <optional>
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
@@ -28,7 +32,12 @@ struct SimOptions {
   std::string ev_to;
   double ev_depart_s = 200.0;
   double demand_end_s = 900.0;
-  double end_s = 1800.0;
+  std::optional<double> end_s;
+  double demand_scale = 1.0;
+  std::string background_routes;
+  std::string run_name;
+  std::string result_file;
+  bool no_ev = false;
   double congestion_period_s = 10.0;
   std::uint32_t incidents = 2;
   bool libsumo = false;
@@ -46,26 +55,44 @@ sim::EvRouting parse_routing(const std::string& s) {
 }
 
 sim::EvSignals parse_signals(const std::string& s) {
-  if (s == "none") return sim::EvSignals::none;
-  if (s == "bluelight") return sim::EvSignals::bluelight;
-  if (s == "corridor") return sim::EvSignals::corridor;
-  throw UsageError("--signals must be none, bluelight or corridor, got '" + s + "'");
+  if (const auto signals = sim::parse_ev_signals(s)) return *signals;
+  throw UsageError("--signals must be none, bluelight, corridor or corridor+bluelight, got '" + s + "'");
 }
 
 void run_sim(const SimOptions& o) {
   if (!(o.volume > 0.0 && o.volume <= 20000.0)) throw UsageError("--volume must be in (0, 20000] vehicles/hour");
+  if (!(o.demand_scale > 0.0 && o.demand_scale <= 20.0)) throw UsageError("--demand-scale must be in (0, 20]");
   if (!(o.congestion_period_s >= 1.0)) throw UsageError("--congestion-period-s must be at least 1");
-  if (!(o.end_s > o.ev_depart_s && o.ev_depart_s >= 0.0)) throw UsageError("--end-s must come after --ev-depart-s");
+  if (!(o.ev_depart_s >= 0.0)) throw UsageError("--ev-depart-s must be >= 0");
+  if (o.end_s && !(*o.end_s > o.ev_depart_s)) throw UsageError("--end-s must come after --ev-depart-s");
+  const auto routing = parse_routing(o.routing);
+  const auto signals = parse_signals(o.signals);
   const auto net = sim::build_scenario_net(o.scenario, o.work_dir);
-  const auto scenario = sim::load_sumo_scenario(net.name, net.dir, net.net);
+  if (net.config && !o.background_routes.empty()) {
+    throw UsageError("--background-routes is for generated scenarios; a .sumocfg brings its own demand (use --demand-scale)");
+  }
+  if (!net.config && o.demand_scale != 1.0) {
+    throw UsageError("--demand-scale scales a .sumocfg scenario's own demand; a generated scenario takes --volume");
+  }
+  const auto scenario = sim::load_sumo_scenario(net);
+  // Times are after the scenario's begin: 0 for generated scenarios, the configuration's begin else.
+  const double begin_s = net.config ? net.config->begin_s : 0.0;
+  const double end_after_begin =
+      o.end_s ? *o.end_s : (net.config && net.config->end_s ? *net.config->end_s - begin_s : 1800.0);
+  if (!(end_after_begin > o.ev_depart_s)) {
+    throw UsageError(fmt::format("the scenario ends {:g} s after its begin, before the EV departs (--ev-depart-s {:g})",
+                                 end_after_begin, o.ev_depart_s));
+  }
   sim::ClosedLoopConfig c;
-  c.routing = parse_routing(o.routing);
-  c.signals = parse_signals(o.signals);
+  c.with_ev = !o.no_ev;
+  c.routing = routing;
+  c.signals = signals;
   std::tie(c.ev_from, c.ev_to) = sim::pick_ev_trip(*scenario, o.seed);
   if (!o.ev_from.empty()) c.ev_from = o.ev_from;
   if (!o.ev_to.empty()) c.ev_to = o.ev_to;
-  c.ev_depart_s = o.ev_depart_s;
-  c.end_s = o.end_s;
+  c.ev_depart_s = begin_s + o.ev_depart_s;
+  c.end_s = begin_s + end_after_begin;
+  c.demand_scale = o.demand_scale;
   c.seed = o.seed;
   c.congestion_period_s = o.congestion_period_s;
   c.incidents = o.incidents;
@@ -96,19 +123,47 @@ void run_sim(const SimOptions& o) {
     if (env == nullptr || *env == '\0') throw UsageError("--server needs --token (or $CORRIDOR_TOKEN) with the dispatcher and vehicle roles");
     c.server_token = env;
   }
-  c.background_routes = sim::build_background_demand(net, {o.volume, o.demand_end_s, o.seed});
+  if (!net.config) {
+    if (!o.background_routes.empty()) {
+      if (!std::filesystem::is_regular_file(o.background_routes)) {
+        throw UsageError("--background-routes: '" + o.background_routes + "' does not exist");
+      }
+      c.background_routes = std::filesystem::absolute(o.background_routes);
+    } else {
+      c.background_routes = sim::build_background_demand(net, {o.volume, o.demand_end_s, o.seed});
+    }
+  }
   c.out_dir = net.dir / "runs";
-  c.run_name = std::string(sim::to_string(c.routing)) + "_" + sim::to_string(c.signals);
-  const auto r = sim::run_closed_loop(*scenario, c);
-  nlohmann::json out = r;
-  out["scenario"] = net.name;
-  out["ev_from"] = c.ev_from;
-  out["ev_to"] = c.ev_to;
-  out["routing"] = o.routing;
-  out["signals"] = o.signals;
-  out["volume"] = o.volume;
-  out["seed"] = o.seed;
-  std::cout << out.dump(2) << '\n';
+  c.run_name = o.run_name;
+  if (c.run_name.empty()) {
+    c.run_name = c.with_ev ? std::string(sim::to_string(c.routing)) + "_" + sim::to_string(c.signals) : "baseline";
+    std::replace(c.run_name.begin(), c.run_name.end(), '+', '_');
+  }
+  if (c.run_name.find_first_of("/\\") != std::string::npos || c.run_name.starts_with('.')) {
+    throw UsageError("--run-name must be a plain file name, got '" + c.run_name + "'");
+  }
+  sim::RunRecord record;
+  record.scenario = net.name;
+  record.with_ev = c.with_ev;
+  record.routing = c.routing;
+  record.signals = c.signals;
+  record.volume = net.config ? 0.0 : o.volume;
+  record.demand_scale = c.demand_scale;
+  record.seed = o.seed;
+  record.ev_from = c.ev_from;
+  record.ev_to = c.ev_to;
+  record.ev_depart_s = c.ev_depart_s;
+  record.result = sim::run_closed_loop(*scenario, c);
+  const std::string text = sim::to_json_record(record).dump(2);
+  if (!o.result_file.empty()) {
+    // Written whole under a temporary name, then renamed: a collector never reads half a record.
+    const std::filesystem::path file(o.result_file);
+    if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+    const auto tmp = file.string() + ".tmp";
+    std::ofstream(tmp, std::ios::trunc) << text << '\n';
+    std::filesystem::rename(tmp, file);
+  }
+  std::cout << text << '\n';
 }
 
 }  // namespace
@@ -116,17 +171,25 @@ void run_sim(const SimOptions& o) {
 void register_sim_command(CLI::App& app) {
   auto o = std::make_shared<SimOptions>();
   auto* cmd = app.add_subcommand("sim", "One closed-loop SUMO run with an emergency vehicle; prints JSON");
-  cmd->add_option("--scenario", o->scenario, "grid, a SUMO .net.xml, or an OSM file")->capture_default_str();
+  cmd->add_option("--scenario", o->scenario, "grid, a SUMO configuration (.sumocfg), a SUMO .net.xml, or an OSM file")
+      ->capture_default_str();
   cmd->add_option("--work-dir", o->work_dir, "scenario files and run outputs")->capture_default_str();
   cmd->add_option("--volume", o->volume, "background vehicles per hour")->capture_default_str();
   cmd->add_option("--seed", o->seed, "random seed (demand, EV trip, incidents, SUMO)")->capture_default_str();
   cmd->add_option("--routing", o->routing, "static or dynamic")->capture_default_str();
-  cmd->add_option("--signals", o->signals, "none, bluelight or corridor")->capture_default_str();
+  cmd->add_option("--signals", o->signals, "none, bluelight, corridor or corridor+bluelight")->capture_default_str();
   cmd->add_option("--ev-from", o->ev_from, "SUMO edge where the EV starts (default: picked from the seed)");
   cmd->add_option("--ev-to", o->ev_to, "SUMO edge where the EV ends");
-  cmd->add_option("--ev-depart-s", o->ev_depart_s, "when the EV departs")->capture_default_str();
+  cmd->add_option("--ev-depart-s", o->ev_depart_s, "when the EV departs, in s after the scenario's begin")->capture_default_str();
   cmd->add_option("--demand-end-s", o->demand_end_s, "background traffic is inserted until then")->capture_default_str();
-  cmd->add_option("--end-s", o->end_s, "the run ends at the latest then")->capture_default_str();
+  cmd->add_option("--end-s", o->end_s,
+                  "the run ends at the latest this many s after the scenario's begin (default: a .sumocfg's end, else 1800)");
+  cmd->add_option("--demand-scale", o->demand_scale, "a .sumocfg's own demand times this (SUMO's --scale)")->capture_default_str();
+  cmd->add_option("--background-routes", o->background_routes,
+                  "a generated scenario's background routes (.rou.xml), instead of building them from --volume");
+  cmd->add_flag("--no-ev", o->no_ev, "run without the EV: the baseline for other vehicles' delay");
+  cmd->add_option("--run-name", o->run_name, "name of this run's files in the work directory (default ROUTING_SIGNALS)");
+  cmd->add_option("--result", o->result_file, "also write the run's record (JSON) to this file, for experiment sumo --collect");
   cmd->add_option("--congestion-period-s", o->congestion_period_s, "how often measured travel times reach the planner")
       ->capture_default_str();
   cmd->add_option("--incidents", o->incidents, "speed drops on the EV's route after it left")->capture_default_str();
@@ -142,48 +205,109 @@ void register_sim_command(CLI::App& app) {
   cmd->callback([o] { run_sim(*o); });
 }
 
+namespace {
+
+std::vector<std::string> split_commas(const std::string& text) {
+  std::vector<std::string> items;
+  std::string item;
+  for (std::size_t i = 0; i <= text.size(); ++i) {
+    if (i == text.size() || text[i] == ',') {
+      items.push_back(item);
+      item.clear();
+    } else {
+      item += text[i];
+    }
+  }
+  return items;
+}
+
+std::vector<double> parse_numbers(const std::string& option, const std::string& text) {
+  std::vector<double> out;
+  for (const std::string& item : split_commas(text)) {
+    try {
+      std::size_t used = 0;
+      const double v = std::stod(item, &used);
+      if (used != item.size() || !std::isfinite(v)) throw std::invalid_argument(item);
+      out.push_back(v);
+    } catch (const std::exception&) {
+      throw UsageError(option + " expects numbers separated by commas, such as 1,1.5; got '" + text + "'");
+    }
+  }
+  return out;
+}
+
+// The path of this executable, for emitted command lines that run it again.
+std::filesystem::path self_binary() {
+  std::error_code ec;
+  const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  return ec ? std::filesystem::path("corridor") : exe;
+}
+
+}  // namespace
+
 void register_sumo_experiment(CLI::App& experiment) {
   auto o = std::make_shared<sim::SumoExperimentOptions>();
   auto volumes = std::make_shared<std::string>("200,400,600,800");
+  auto scales = std::make_shared<std::string>("1");
+  auto signals = std::make_shared<std::string>("none,bluelight,corridor,corridor+bluelight");
+  auto routings = std::make_shared<std::string>("static,dynamic");
+  auto emit_jobs = std::make_shared<std::string>();
+  auto collect = std::make_shared<std::vector<std::string>>();
+  auto end_s = std::make_shared<std::optional<double>>();
   auto* cmd = experiment.add_subcommand(
-      "sumo", "Closed-loop SUMO matrix: static/dynamic routing x none/bluelight/corridor signals over volumes and seeds");
-  cmd->add_option("--scenario", o->scenario, "grid, a SUMO .net.xml, or an OSM file (.osm, .osm.gz, .osm.pbf)")
+      "sumo", "Closed-loop SUMO matrix: routing x signal strategies over demand levels and seeds; run here, or emit and collect");
+  cmd->add_option("--scenario", o->scenario, "grid, a SUMO configuration (.sumocfg), a .net.xml, or an OSM file")
       ->capture_default_str();
-  cmd->add_option("--volumes", *volumes, "background volumes, vehicles/hour, comma-separated")->capture_default_str();
-  cmd->add_option("--seeds", o->seeds, "seeds per volume")->capture_default_str();
+  cmd->add_option("--volumes", *volumes, "generated scenarios: background volumes, vehicles/hour, comma-separated")
+      ->capture_default_str();
+  cmd->add_option("--demand-scale", *scales, "a .sumocfg's own demand times these (SUMO's --scale), comma-separated")
+      ->capture_default_str();
+  cmd->add_option("--signals", *signals, "signal strategies, comma-separated")->capture_default_str();
+  cmd->add_option("--routings", *routings, "EV routing, comma-separated")->capture_default_str();
+  cmd->add_option("--seeds", o->seeds, "seeds per demand level")->capture_default_str();
   cmd->add_option("--first-seed", o->first_seed, "seeds are first-seed, first-seed+1, ...")->capture_default_str();
-  cmd->add_option("--out", o->out_dir, "output directory")->required();
-  cmd->add_option("--demand-end-s", o->demand_end_s, "background traffic is inserted until then")->capture_default_str();
-  cmd->add_option("--ev-depart-s", o->ev_depart_s, "when the EV departs")->capture_default_str();
-  cmd->add_option("--end-s", o->end_s, "every run ends at the latest then")->capture_default_str();
+  cmd->add_option("--out", o->out_dir, "output directory (runs, tables and plots)")->required();
+  cmd->add_option("--demand-end-s", o->demand_end_s, "generated background traffic is inserted until then")->capture_default_str();
+  cmd->add_option("--ev-depart-s", o->ev_depart_s, "when the EV departs, in s after the scenario's begin")->capture_default_str();
+  cmd->add_option("--end-s", *end_s, "runs end at the latest this many s after the begin (default: a .sumocfg's end, else 2400)");
   cmd->add_option("--congestion-period-s", o->congestion_period_s, "how often measured travel times reach the planner")
       ->capture_default_str();
   cmd->add_option("--incidents", o->incidents, "speed drops on the EV's route after it left")->capture_default_str();
   cmd->add_option("--parallel", o->parallel, "SUMO runs at a time")->capture_default_str();
+  cmd->add_option("--emit-jobs", *emit_jobs,
+                  "write one `corridor sim` command line per run to this file instead of running them (for GNU parallel, "
+                  "SSH hosts or a Slurm array), then --collect");
+  cmd->add_option("--collect", *collect, "merge the run records (*.run.json) under these directories into --out")
+      ->expected(1, -1);
   auto libsumo = std::make_shared<bool>(false);
   cmd->add_flag("--libsumo", *libsumo, "run SUMO inside each run's process (libsumo) instead of over TraCI");
-  cmd->callback([o, volumes, libsumo] {
-    o->backend = *libsumo ? sim::SumoBackend::libsumo : sim::SumoBackend::traci;
-    o->volumes.clear();
-    std::string item;
-    for (std::size_t i = 0; i <= volumes->size(); ++i) {
-      if (i == volumes->size() || (*volumes)[i] == ',') {
-        try {
-          std::size_t used = 0;
-          const double v = std::stod(item, &used);
-          if (used != item.size()) throw std::invalid_argument(item);
-          o->volumes.push_back(v);
-        } catch (const std::exception&) {
-          throw UsageError("--volumes expects numbers separated by commas, such as 200,400,600; got '" + *volumes + "'");
-        }
-        item.clear();
-      } else {
-        item += (*volumes)[i];
-      }
+  cmd->callback([o, volumes, scales, signals, routings, emit_jobs, collect, end_s, libsumo] {
+    if (!emit_jobs->empty() && !collect->empty()) throw UsageError("--emit-jobs and --collect are two steps: give one");
+    if (!collect->empty()) {
+      std::vector<std::filesystem::path> dirs(collect->begin(), collect->end());
+      sim::collect_sumo_experiment(dirs, o->out_dir);
+      std::ifstream md(o->out_dir / "sumo_summary.md");
+      std::cout << md.rdbuf() << "\nOutput in " << o->out_dir.string() << "\n";
+      return;
     }
+    o->backend = *libsumo ? sim::SumoBackend::libsumo : sim::SumoBackend::traci;
+    o->volumes = parse_numbers("--volumes", *volumes);
+    o->demand_scales = parse_numbers("--demand-scale", *scales);
+    o->end_s = *end_s;
+    o->signals.clear();
+    for (const std::string& s : split_commas(*signals)) o->signals.push_back(parse_signals(s));
+    o->routings.clear();
+    for (const std::string& r : split_commas(*routings)) o->routings.push_back(parse_routing(r));
     if (o->seeds == 0 || o->seeds > 1000) throw UsageError("--seeds must be in [1, 1000]");
     if (o->parallel == 0 || o->parallel > 64) throw UsageError("--parallel must be in [1, 64]");
-    if (!(o->end_s > o->ev_depart_s)) throw UsageError("--end-s must come after --ev-depart-s");
+    if (o->end_s && !(*o->end_s > o->ev_depart_s)) throw UsageError("--end-s must come after --ev-depart-s");
+    if (!emit_jobs->empty()) {
+      const std::size_t n = sim::emit_sumo_jobs(*o, *emit_jobs, self_binary());
+      std::cout << n << " runs written to " << *emit_jobs << ". Run them, for example with\n  parallel -j2 < " << *emit_jobs
+                << "\nthen merge the results:\n  corridor experiment sumo --collect " << (o->out_dir / "runs").string()
+                << " --out " << o->out_dir.string() << "\n";
+      return;
+    }
     sim::run_sumo_experiment(*o);
     std::ifstream md(o->out_dir / "sumo_summary.md");
     std::cout << md.rdbuf() << "\nOutput in " << o->out_dir.string() << "\n";

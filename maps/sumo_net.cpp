@@ -52,6 +52,8 @@ std::vector<Point2> parse_shape(const std::string& text) {
 struct ParseState {
   SumoNet net;
   std::string error;
+  XML_Parser parser = nullptr;
+  bool stop_at_net = false;  // read_sumo_net_version: stop at the <net> element
 };
 
 void on_start(void* user, const char* name, const char** attrs) {
@@ -89,6 +91,9 @@ void on_start(void* user, const char* name, const char** attrs) {
     net.tl_logics.push_back({a.str("id"), a.str("programID"), a.str("type"), {}});
   } else if (std::strcmp(name, "phase") == 0 && !net.tl_logics.empty()) {
     net.tl_logics.back().phases.push_back({a.number("duration"), a.str("state"), a.number("minDur", 0.0)});
+  } else if (std::strcmp(name, "net") == 0) {
+    net.version = a.str("version");
+    if (st.stop_at_net) XML_StopParser(st.parser, XML_FALSE);
   } else if (std::strcmp(name, "location") == 0) {
     const auto offset = parse_shape(a.str("netOffset"));
     if (!offset.empty()) net.net_offset = offset.front();
@@ -142,11 +147,15 @@ const SumoJunction* SumoNet::junction(const std::string& id) const {
   return nullptr;
 }
 
-SumoNet read_sumo_net(const std::filesystem::path& file) {
+namespace {
+
+// Parses a SUMO XML file (net or additional) into st.net. Returns false when the parse stopped
+// early on request (stop_at_net).
+bool parse_sumo_xml(const std::filesystem::path& file, const char* what, ParseState& st) {
   std::ifstream in(file, std::ios::binary);
-  if (!in) throw MapLoadError("SUMO network not found: '" + file.string() + "'");
+  if (!in) throw MapLoadError(std::string(what) + " not found: '" + file.string() + "'");
   std::unique_ptr<XML_ParserStruct, decltype(&XML_ParserFree)> parser(XML_ParserCreate(nullptr), &XML_ParserFree);
-  ParseState st;
+  st.parser = parser.get();
   XML_SetUserData(parser.get(), &st);
   XML_SetStartElementHandler(parser.get(), on_start);
   std::vector<char> buf(1 << 16);
@@ -154,16 +163,40 @@ SumoNet read_sumo_net(const std::filesystem::path& file) {
     in.read(buf.data(), static_cast<std::streamsize>(buf.size()));
     const auto n = static_cast<int>(in.gcount());
     const bool last = n < static_cast<int>(buf.size());
-    if (XML_Parse(parser.get(), buf.data(), n, last ? 1 : 0) == XML_STATUS_ERROR) {
+    const XML_Status status = XML_Parse(parser.get(), buf.data(), n, last ? 1 : 0);
+    if (status == XML_STATUS_SUSPENDED || (status == XML_STATUS_ERROR && XML_GetErrorCode(parser.get()) == XML_ERROR_ABORTED)) {
+      return false;
+    }
+    if (status == XML_STATUS_ERROR) {
       throw MapLoadError("'" + file.string() + "' is not valid XML at line " +
                          std::to_string(XML_GetCurrentLineNumber(parser.get())) + ": " +
                          XML_ErrorString(XML_GetErrorCode(parser.get())));
     }
     if (!st.error.empty()) throw MapLoadError("'" + file.string() + "': " + st.error);
-    if (last) break;
+    if (last) return true;
   }
+}
+
+}  // namespace
+
+SumoNet read_sumo_net(const std::filesystem::path& file) {
+  ParseState st;
+  parse_sumo_xml(file, "SUMO network", st);
   if (st.net.edges.empty()) throw MapLoadError("'" + file.string() + "' holds no SUMO edges: is it a .net.xml?");
   return std::move(st.net);
+}
+
+std::vector<SumoTlLogic> read_sumo_tl_logics(const std::filesystem::path& file) {
+  ParseState st;
+  parse_sumo_xml(file, "SUMO additional file", st);
+  return std::move(st.net.tl_logics);
+}
+
+std::string read_sumo_net_version(const std::filesystem::path& file) {
+  ParseState st;
+  st.stop_at_net = true;
+  parse_sumo_xml(file, "SUMO network", st);
+  return st.net.version;
 }
 
 std::vector<SumoSignalPlan> sumo_signal_plans(const SumoNet& net, double min_all_red_s) {

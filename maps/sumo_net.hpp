@@ -70,6 +70,7 @@ struct SumoNet {
   std::vector<SumoTlLogic> tl_logics;
   Point2 net_offset;
   std::string proj_parameter;
+  std::string version;  // <net version="1.9">: the netconvert release that wrote the file
 
   [[nodiscard]] const SumoEdge* edge(const std::string& id) const;
   [[nodiscard]] const SumoJunction* junction(const std::string& id) const;
@@ -77,6 +78,15 @@ struct SumoNet {
 
 // Throws MapLoadError for a missing file or malformed XML, naming the file and line.
 SumoNet read_sumo_net(const std::filesystem::path& file);
+
+// The traffic-light programs (<tlLogic>) of an additional file, in file order. SUMO makes the last
+// program loaded for a light its active one, so a scenario's additional programs replace the net's.
+// Throws MapLoadError for a missing file or malformed XML.
+std::vector<SumoTlLogic> read_sumo_tl_logics(const std::filesystem::path& file);
+
+// The version attribute of a .net.xml's <net> element, read without parsing the rest; empty when
+// the file has none. Throws MapLoadError for a missing file or XML that breaks before <net>.
+std::string read_sumo_net_version(const std::filesystem::path& file);
 
 // One traffic light's plan. plan.movements[i] is SUMO link i of the program (state[i]).
 struct SumoSignalPlan {

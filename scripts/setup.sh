@@ -9,7 +9,7 @@ packages=(
   libgeographiclib-dev libcli11-dev libspdlog-dev libfmt-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libopencv-dev libeigen3-dev libceres-dev
-  osmium-tool sumo sumo-tools python3 curl
+  osmium-tool sumo sumo-tools python3 curl parallel
   chromium
 )
 # The console (web/) builds with Node.js and npm; a machine that already has a Node.js with its own

@@ -33,7 +33,7 @@ namespace corridor::server {
 struct DispatchConfig {
   double snap_max_distance_m = 200.0;
   double arrival_radius_m = 30.0;  // closer than this to the destination completes the mission
-  double signal_delay_s = 15.0;    // expected delay at a signalized intersection, for routing
+  double signal_delay_s = 15.0;    // expected delay at a signalized intersection without a plan, for routing
   // Threads that repair missions' plans after a congestion change, the calling one included.
   int repair_threads = 2;
   preemption::PreemptionConfig preemption;

@@ -38,13 +38,20 @@ std::string as_string(const libsumo::TraCIResults& r, int var) {
 void write_ev_types(const std::filesystem::path& file, double vmax_mps) {
   std::ofstream out(file, std::ios::trunc);
   // The EV drives at the speed limit (speedFactor 1), like the planner's cost model, up to vmax.
-  // The bluelight type may pass red lights slowly, as SUMO users configure it.
+  // The bluelight type may pass red lights slowly, as SUMO users configure it. With Corridor's
+  // preemption as well (corridor+bluelight), the EV keeps the device (others make way) but waits at
+  // a red: SUMO's other drivers do not yield to a vehicle crossing on red, so red running collides
+  // in the junction, and the preemption is there to turn that red green in time.
   out << fmt::format(
       "<additional>\n"
       "  <vType id=\"ev\" vClass=\"emergency\" guiShape=\"emergency\" color=\"1,0,0\" maxSpeed=\"{0:.3f}\" "
       "speedFactor=\"1\" speedDev=\"0\"/>\n"
       "  <vType id=\"ev_bluelight\" vClass=\"emergency\" guiShape=\"emergency\" color=\"0,0,1\" maxSpeed=\"{0:.3f}\" "
       "speedFactor=\"1\" speedDev=\"0\" jmDriveAfterRedTime=\"300\" jmDriveRedSpeed=\"5.56\">\n"
+      "    <param key=\"has.bluelight.device\" value=\"true\"/>\n"
+      "  </vType>\n"
+      "  <vType id=\"ev_bluelight_preempted\" vClass=\"emergency\" guiShape=\"emergency\" color=\"1,0,1\" "
+      "maxSpeed=\"{0:.3f}\" speedFactor=\"1\" speedDev=\"0\">\n"
       "    <param key=\"has.bluelight.device\" value=\"true\"/>\n"
       "  </vType>\n"
       "</additional>\n",
@@ -90,15 +97,34 @@ std::vector<Approach> approaches_of(const SumoScenario& scenario) {
 SumoLaunch launch_for(const SumoScenario& scenario, const ClosedLoopConfig& config) {
   SumoLaunch launch;
   launch.net = scenario.net_file;
+  launch.scale = config.demand_scale;
   if (!config.background_routes.empty()) launch.routes.push_back(config.background_routes);
-  const auto types = config.out_dir / "ev_types.add.xml";
+  std::error_code ec;
+  if (scenario.config) {
+    launch.config = scenario.config->file;
+    // The scenario's additional files are copied into the run directory, so that the outputs they
+    // declare (detector files, relative to the additional file) land there and not beside the
+    // user's files.
+    const auto inputs = config.out_dir / (config.run_name + ".inputs");
+    std::filesystem::create_directories(inputs, ec);
+    for (const auto& file : scenario.config->additional_files) {
+      const auto copy = inputs / file.filename();
+      std::filesystem::copy_file(file, copy, std::filesystem::copy_options::overwrite_existing, ec);
+      if (ec) throw SimError("cannot copy " + file.string() + " into " + inputs.string() + ": " + ec.message());
+      launch.additional.push_back(copy);
+    }
+    for (const auto& [option, value] : scenario.config->outputs) {
+      if (option == "tripinfo-output") continue;  // the run's own, below
+      launch.options.emplace_back(option, (config.out_dir / (config.run_name + "." + std::filesystem::path(value).filename().string())).string());
+    }
+  }
+  const auto types = config.out_dir / (config.run_name + ".ev_types.add.xml");
   write_ev_types(types, config.ev_vmax_kmh / 3.6);
   launch.additional.push_back(types);
   launch.tripinfo = config.out_dir / (config.run_name + ".tripinfo.xml");
   launch.log = config.out_dir / (config.run_name + ".sumo.log");
   launch.end_s = config.end_s;
   launch.seed = config.seed;
-  std::error_code ec;
   std::filesystem::remove(launch.tripinfo, ec);
   std::filesystem::remove(launch.log, ec);
   return launch;
@@ -149,8 +175,16 @@ const char* to_string(EvSignals s) {
     case EvSignals::none: return "none";
     case EvSignals::bluelight: return "bluelight";
     case EvSignals::corridor: return "corridor";
+    case EvSignals::corridor_bluelight: return "corridor+bluelight";
   }
   return "?";
+}
+
+std::optional<EvSignals> parse_ev_signals(const std::string& text) {
+  for (EvSignals s : {EvSignals::none, EvSignals::bluelight, EvSignals::corridor, EvSignals::corridor_bluelight}) {
+    if (text == to_string(s)) return s;
+  }
+  return std::nullopt;
 }
 
 std::pair<std::string, std::string> pick_ev_trip(const SumoScenario& scenario, std::uint64_t seed) {
@@ -161,6 +195,9 @@ std::pair<std::string, std::string> pick_ev_trip(const SumoScenario& scenario, s
   const planner::TravelCost cost(g, overlay, {});
   planner::OneToOneSearch search;
   const auto m = static_cast<std::uint32_t>(g.edge_count());
+  std::set<std::string> all_lights;
+  for (const auto& plan : scenario.sumo_plans) all_lights.insert(plan.tls_id);
+  const std::size_t wanted_lights = std::min<std::size_t>(2, all_lights.size());
   for (int attempt = 0; attempt < 20000; ++attempt) {
     const EdgeId a{rng.below(m)};
     const EdgeId b{rng.below(m)};
@@ -168,11 +205,12 @@ std::pair<std::string, std::string> pick_ev_trip(const SumoScenario& scenario, s
     if (a == b || d < 0.5 * diagonal * (1.0 - attempt / 40000.0)) continue;
     const planner::SearchSpace space(cost, {{a, 0.0}}, {{b, g.length_m(b)}});
     const planner::Route r = search.run(space, true);
-    // A trip that crosses at least one traffic light, where the net has any: preemption is the point.
-    const bool crosses_light = scenario.plans.empty() || std::any_of(r.nodes.begin(), r.nodes.end(), [&](NodeId v) {
-                                 return scenario.plans.contains(v);
-                               });
-    if (r.found && r.edges.size() >= 4 && (crosses_light || attempt > 15000)) {
+    // A trip that crosses at least two traffic lights, where the net has them: preemption is the point.
+    std::set<std::string> lights;
+    for (NodeId v : r.nodes) {
+      if (const auto it = scenario.sumo_plan_of.find(v); it != scenario.sumo_plan_of.end()) lights.insert(it->second->tls_id);
+    }
+    if (r.found && r.edges.size() >= 4 && (lights.size() >= wanted_lights || attempt > 15000)) {
       return {scenario.graph.sumo_edge_of_arc[a.index()], scenario.graph.sumo_edge_of_arc[b.index()]};
     }
   }

@@ -19,9 +19,16 @@ enum class EvRouting { static_route, dynamic_route };
 // How Corridor talks to SUMO: TraCI over a socket to a sumo process (libtracicpp), or SUMO inside
 // this process (libsumocpp): faster for batch runs, and one simulation per process.
 enum class SumoBackend { traci, libsumo };
-enum class EvSignals { none, bluelight, corridor };
+// none: an ordinary vehicle; bluelight: SUMO's bluelight device (others make way, red lights are
+// passed slowly); corridor: Corridor preempts the lights ahead; corridor_bluelight: both, which is
+// what a real ambulance is: a vehicle with siren privileges whose lights are also preempted.
+enum class EvSignals { none, bluelight, corridor, corridor_bluelight };
 const char* to_string(EvRouting r);
-const char* to_string(EvSignals s);
+const char* to_string(EvSignals s);  // "none", "bluelight", "corridor", "corridor+bluelight"
+// The inverse of to_string; nullopt for anything else.
+std::optional<EvSignals> parse_ev_signals(const std::string& text);
+[[nodiscard]] inline bool preempts(EvSignals s) { return s == EvSignals::corridor || s == EvSignals::corridor_bluelight; }
+[[nodiscard]] inline bool has_bluelight(EvSignals s) { return s == EvSignals::bluelight || s == EvSignals::corridor_bluelight; }
 
 struct ClosedLoopConfig {
   bool with_ev = true;  // false: the baseline run for other vehicles' delay
@@ -42,6 +49,7 @@ struct ClosedLoopConfig {
   double end_s = 1800.0;
   std::uint64_t seed = 1;
   std::filesystem::path background_routes;
+  double demand_scale = 1.0;  // SUMO's --scale on all demand (a user's scenario's own)
   std::filesystem::path out_dir;  // logs and tripinfo of this run
   std::string run_name = "run";
   // With a server: what the EV's receiver reports. 0 m posts SUMO's true positions, as before;
@@ -79,7 +87,7 @@ struct ClosedLoopResult {
 ClosedLoopResult run_closed_loop(const SumoScenario& scenario, const ClosedLoopConfig& config);
 
 // A start and goal for the EV: far apart, connected, on edges SUMO lets it drive, and with at
-// least one traffic light between them where the network has any.
+// least two traffic lights between them where the network has two.
 std::pair<std::string, std::string> pick_ev_trip(const SumoScenario& scenario, std::uint64_t seed);
 
 }  // namespace corridor::sim

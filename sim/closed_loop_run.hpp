@@ -20,6 +20,7 @@
 #include "planner/experiments/scenario_generator.hpp"
 #include "planner/one_to_one_search.hpp"
 #include "preemption/engine.hpp"
+#include "preemption/signal_costs.hpp"
 #include "sim/closed_loop.hpp"
 #include "sim/errors.hpp"
 #include "sim/sumo_bridge.hpp"
@@ -40,6 +41,14 @@ inline constexpr preemption::MissionId kMission = 1;
 double as_double(const libsumo::TraCIResults& r, int var);
 std::string as_string(const libsumo::TraCIResults& r, int var);
 void write_ev_types(const std::filesystem::path& file, double vmax_mps);
+// The vehicle type write_ev_types defines for a signal strategy.
+inline const char* ev_type(EvSignals s) {
+  switch (s) {
+    case EvSignals::bluelight: return "ev_bluelight";
+    case EvSignals::corridor_bluelight: return "ev_bluelight_preempted";
+    default: return "ev";
+  }
+}
 std::vector<std::string> sumo_ids(const maps::SumoGraph& g, std::span<const EdgeId> arcs);
 // Every graph edge that puts the vehicle on `sumo_edge`, at `offset_m` (one per way onto it).
 std::vector<planner::EdgePoint> points_on(const maps::SumoGraph& g, const std::string& sumo_edge,
@@ -105,6 +114,9 @@ ClosedLoopResult run_loop(const SumoScenario& scenario, const ClosedLoopConfig& 
   const double vmax_mps = config.ev_vmax_kmh / 3.6;
 
   planner::CostOverlay overlay(g);
+  // The route knows its own preemption: the server's rule (preemption/signal_costs.hpp).
+  preemption::set_signal_costs(overlay, scenario.plans,
+                               preempts(config.signals) ? preemption::SignalCostRule::preempted : preemption::SignalCostRule::normal);
   const planner::TravelCost cost(g, overlay, {vmax_mps});
   const std::vector<planner::EdgePoint> starts = points_on(sg, config.ev_from, 0.0);
   const std::vector<planner::EdgePoint> goals = points_on(sg, config.ev_to, std::nullopt);
@@ -201,7 +213,7 @@ ClosedLoopResult run_loop(const SumoScenario& scenario, const ClosedLoopConfig& 
       if (!r.found) throw SimError("the EV's goal cannot be reached from its start");
       route = r.edges;
       Api::Route::add("ev_route", sumo_ids(sg, route));
-      Api::Vehicle::add(kEv, "ev_route", config.signals == EvSignals::bluelight ? "ev_bluelight" : "ev", "now",
+      Api::Vehicle::add(kEv, "ev_route", ev_type(config.signals), "now",
                              "best", "base", "max");
       Api::Vehicle::subscribe(kEv, {libsumo::VAR_ROAD_ID, libsumo::VAR_LANEPOSITION, libsumo::VAR_SPEED});
       ev_added = true;
@@ -223,13 +235,13 @@ ClosedLoopResult run_loop(const SumoScenario& scenario, const ClosedLoopConfig& 
           ev_done = true;
           result.ev_arrived = true;
           result.ev_travel_time_s = t - ev_depart;
-          if (config.signals == EvSignals::corridor) engine.cancel(kMission, t);
+          if (preempts(config.signals)) engine.cancel(kMission, t);
         }
       } else {
         ev_seen = true;
         const std::string road = as_string(ev, libsumo::VAR_ROAD_ID);
         if (!road.empty() && road[0] != ':' && !sg.arcs(road).empty()) {
-          if (road != ev_edge && config.signals == EvSignals::corridor) {
+          if (road != ev_edge && preempts(config.signals)) {
             // Onto a new edge: the EV has crossed the stop line of the one it left.
             engine.vehicle_passed(kMission, sg.stop_line.at(ev_edge), t);
           }
@@ -264,13 +276,13 @@ ClosedLoopResult run_loop(const SumoScenario& scenario, const ClosedLoopConfig& 
                                      std::vector<EdgeId>(route.begin() + static_cast<std::ptrdiff_t>(route_index), route.end()),
                                      {route.back(), g.length_m(route.back())});
         }
-        if (config.signals == EvSignals::corridor && plan.found) {
+        if (preempts(config.signals) && plan.found) {
           const auto crossings = preemption::signalized_crossings(plan, scenario.plans, t);
           engine.update_route(kMission, 1, crossings, t);
         }
       }
     }
-    if (config.signals == EvSignals::corridor) {
+    if (preempts(config.signals)) {
       engine.tick(t);
       controller.update(t);
       for (const auto& ev : engine.take_events()) {

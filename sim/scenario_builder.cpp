@@ -4,6 +4,7 @@
 
 #include <cstdlib>
 
+#include "maps/sumo_net.hpp"
 #include "sim/errors.hpp"
 #include "sim/process.hpp"
 
@@ -21,6 +22,17 @@ void prepare(const std::filesystem::path& dir) {
   if (ec) throw SimError("cannot create the scenario directory '" + dir.string() + "': " + ec.message());
 }
 
+// A net newer than the installed SUMO is refused before SUMO misreads it.
+void check_net_readable(const std::filesystem::path& net) {
+  std::string version;
+  try {
+    version = maps::read_sumo_net_version(net);
+  } catch (const std::exception& e) {
+    throw SimError(e.what());
+  }
+  check_net_version(net, version, installed_sumo_version());
+}
+
 bool up_to_date(const std::filesystem::path& out, const std::filesystem::path& input) {
   std::error_code ec;
   return std::filesystem::exists(out) && std::filesystem::file_size(out, ec) > 0 &&
@@ -36,7 +48,7 @@ ScenarioNet build_grid_net(const std::filesystem::path& dir, const GridSpec& spe
   }
   prepare(dir);
   const std::string name = fmt::format("grid{}x{}", spec.blocks, spec.blocks);
-  ScenarioNet net{name, dir, dir / (name + ".net.xml")};
+  ScenarioNet net{name, dir, dir / (name + ".net.xml"), std::nullopt};
   if (up_to_date(net.net, {})) return net;
   run_tool({"netgenerate", "--grid", "--grid.number", std::to_string(spec.blocks), "--grid.length",
             fmt::format("{}", spec.block_m), "--default.lanenumber", std::to_string(spec.lanes), "--default.speed",
@@ -51,7 +63,7 @@ ScenarioNet build_osm_net(const std::filesystem::path& dir, const std::filesyste
   prepare(dir);
   std::string name = osm_file.filename().string();
   name = name.substr(0, name.find('.'));
-  ScenarioNet net{name, dir, dir / (name + ".net.xml")};
+  ScenarioNet net{name, dir, dir / (name + ".net.xml"), std::nullopt};
   if (up_to_date(net.net, osm_file)) return net;
   std::filesystem::path input = osm_file;
   if (osm_file.extension() == ".pbf") {
@@ -69,13 +81,20 @@ ScenarioNet build_scenario_net(const std::string& scenario, const std::filesyste
   if (scenario == "grid") return build_grid_net(dir, GridSpec{});
   const std::filesystem::path file(scenario);
   if (!std::filesystem::exists(file)) {
-    throw SimError("--scenario must be grid, a .net.xml, or an OSM file (.osm, .osm.gz, .osm.pbf); '" + scenario +
-                   "' does not exist");
+    throw SimError("--scenario must be grid, a .sumocfg, a .net.xml, or an OSM file (.osm, .osm.gz, .osm.pbf); '" +
+                   scenario + "' does not exist");
   }
   const std::string name = file.filename().string();
-  if (name.size() > 8 && name.ends_with(".net.xml")) {
+  if (name.size() > 8 && name.ends_with(".sumocfg")) {
+    SumoConfig config = read_sumo_config(file);
+    check_net_readable(config.net_file);
     prepare(dir);
-    return ScenarioNet{name.substr(0, name.size() - 8), dir, std::filesystem::absolute(file)};
+    return ScenarioNet{name.substr(0, name.size() - 8), dir, config.net_file, std::move(config)};
+  }
+  if (name.size() > 8 && name.ends_with(".net.xml")) {
+    check_net_readable(file);
+    prepare(dir);
+    return ScenarioNet{name.substr(0, name.size() - 8), dir, std::filesystem::absolute(file), std::nullopt};
   }
   if (name.ends_with(".osm") || name.ends_with(".osm.gz") || name.ends_with(".pbf")) return build_osm_net(dir, file);
   throw SimError("'" + scenario + "' is neither a SUMO .net.xml nor an OSM file (.osm, .osm.gz, .osm.pbf)");

@@ -4,7 +4,10 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
+
+#include "sim/sumo_config.hpp"
 
 namespace corridor::sim {
 
@@ -16,9 +19,11 @@ struct GridSpec {
 };
 
 struct ScenarioNet {
-  std::string name;  // "grid", or the OSM file's stem
+  std::string name;  // "grid", or the OSM file's or configuration's stem
   std::filesystem::path dir;
   std::filesystem::path net;
+  // A user's scenario (.sumocfg): its own demand is the background traffic, and SUMO runs it with -c.
+  std::optional<SumoConfig> config;
 };
 
 // A grid like the seed paper's: two lanes per direction, a traffic light at every junction.
@@ -28,7 +33,10 @@ ScenarioNet build_grid_net(const std::filesystem::path& dir, const GridSpec& spe
 // A .pbf is first converted to .osm with osmium-tool, since netconvert does not read PBF.
 ScenarioNet build_osm_net(const std::filesystem::path& dir, const std::filesystem::path& osm_file);
 
-// "grid" (the default grid), a SUMO .net.xml used as it is, or an OSM file (.osm, .osm.gz, .pbf).
+// "grid" (the default grid), a user's SUMO configuration (.sumocfg), a SUMO .net.xml used as it
+// is, or an OSM file (.osm, .osm.gz, .pbf). A configuration's or net's files are read where they
+// are and never written; `dir` receives what runs produce. Throws SimError for a missing or
+// unusable file, and for a net newer than the installed SUMO.
 ScenarioNet build_scenario_net(const std::string& scenario, const std::filesystem::path& dir);
 
 struct DemandSpec {

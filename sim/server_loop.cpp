@@ -44,7 +44,7 @@ double wall_s() { return std::chrono::duration<double>(std::chrono::system_clock
 
 ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const ClosedLoopConfig& config) {
   using namespace detail;
-  if (config.routing != EvRouting::dynamic_route || config.signals != EvSignals::corridor || !config.with_ev) {
+  if (config.routing != EvRouting::dynamic_route || !preempts(config.signals) || !config.with_ev) {
     throw SimError("--server runs the server's own loop: dynamic routing with Corridor preemption and an EV");
   }
   const auto& sg = scenario.graph;
@@ -94,10 +94,11 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
   std::set<std::uint32_t> preempted;
   std::size_t restored = 0;
   const double wall_start = wall_s();
-  double t = 0.0;
+  const double begin_s = scenario.config ? scenario.config->begin_s : 0.0;  // a user's scenario starts there
+  double t = begin_s;
   for (int step = 0; t < config.end_s; ++step) {
     // SUMO keeps pace with the wall clock, which the server's schedule runs on.
-    const double due = wall_start + t;
+    const double due = wall_start + (t - begin_s);
     if (const double wait = due - wall_s(); wait > 0) std::this_thread::sleep_for(std::chrono::duration<double>(wait));
     t = bridge.step();
     const double now = wall_start + t;
@@ -154,7 +155,7 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
                        config.ev_from + "'");
       }
       libtraci::Route::add("ev_route", route);
-      libtraci::Vehicle::add(kEv, "ev_route", "ev", "now", "best", "base", "max");
+      libtraci::Vehicle::add(kEv, "ev_route", ev_type(config.signals), "now", "best", "base", "max");
       libtraci::Vehicle::subscribe(kEv, {libsumo::VAR_ROAD_ID, libsumo::VAR_POSITION, libsumo::VAR_ANGLE, libsumo::VAR_SPEED});
       ev_added = true;
       ev_depart = t;

@@ -24,7 +24,14 @@ std::atomic<int> bridge_counter{0};
 }  // namespace
 
 std::vector<std::string> sumo_command(const SumoLaunch& launch, std::optional<int> port) {
-  std::vector<std::string> cmd{launch.sumo_binary, "-n", launch.net.string()};
+  std::vector<std::string> cmd{launch.sumo_binary};
+  if (launch.config.empty()) {
+    cmd.insert(cmd.end(), {"-n", launch.net.string()});
+  } else {
+    cmd.insert(cmd.end(), {"-c", launch.config.string()});
+  }
+  if (launch.scale != 1.0) cmd.insert(cmd.end(), {"--scale", fmt::format("{:g}", launch.scale)});
+  for (const auto& [name, value] : launch.options) cmd.insert(cmd.end(), {"--" + name, value});
   if (!launch.routes.empty()) cmd.insert(cmd.end(), {"-r", join_paths(launch.routes)});
   if (!launch.additional.empty()) cmd.insert(cmd.end(), {"-a", join_paths(launch.additional)});
   if (!launch.tripinfo.empty()) {
@@ -32,7 +39,9 @@ std::vector<std::string> sumo_command(const SumoLaunch& launch, std::optional<in
   }
   cmd.insert(cmd.end(), {"--step-length", fmt::format("{:g}", launch.step_length_s), "--end", fmt::format("{:g}", launch.end_s),
                          "--seed", std::to_string(launch.seed), "--no-step-log", "true", "--duration-log.disable", "true",
-                         "--collision.action", "warn", "--time-to-teleport", "300", "--ignore-route-errors", "true"});
+                         "--collision.action", "warn"});
+  // A user's scenario keeps its own teleport and route-error settings.
+  if (launch.config.empty()) cmd.insert(cmd.end(), {"--time-to-teleport", "300", "--ignore-route-errors", "true"});
   if (port) cmd.insert(cmd.end(), {"--remote-port", std::to_string(*port), "--num-clients", "1"});
   return cmd;
 }

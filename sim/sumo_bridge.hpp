@@ -14,6 +14,12 @@
 namespace corridor::sim {
 
 struct SumoLaunch {
+  // A user's configuration, run with -c: its net, demand, programs and options stand, and only the
+  // options below override them. Empty: the net and routes below.
+  std::filesystem::path config;
+  double scale = 1.0;  // SUMO's --scale: the demand's multiplier
+  // Further options set for this run, such as a configuration's outputs sent to the run directory.
+  std::vector<std::pair<std::string, std::string>> options;
   std::filesystem::path net;
   std::vector<std::filesystem::path> routes;
   std::vector<std::filesystem::path> additional;

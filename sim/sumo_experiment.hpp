@@ -1,10 +1,19 @@
 // `corridor experiment sumo`: the closed-loop matrix {static, dynamic} routing x {none, bluelight,
-// corridor} signals over background volumes and seeds, each against a run without the EV, written
-// as CSV, a median/IQR summary and plots. Runs go two at a time, each SUMO in its own process.
+// corridor, corridor+bluelight} signals over demand levels and seeds, each against a run without
+// the EV, written as CSV, a median/IQR summary and plots.
+//
+// A matrix is planned once, then either run here (two at a time, each SUMO run in a forked child),
+// or emitted as one self-contained `corridor sim` command line per run for an existing engine (GNU
+// parallel, over SSH hosts, a Slurm array) and collected afterwards. Every run leaves the same
+// record file (`*.run.json`), and the outputs are always made from those records, so both ways
+// give the same tables.
 #pragma once
+
+#include <nlohmann/json.hpp>
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -13,32 +22,64 @@
 namespace corridor::sim {
 
 struct SumoExperimentOptions {
-  std::string scenario = "grid";  // grid, a .net.xml, or an OSM file
-  std::vector<double> volumes{200, 400, 600, 800};
+  std::string scenario = "grid";  // grid, a user's .sumocfg, a .net.xml, or an OSM file
+  std::vector<double> volumes{200, 400, 600, 800};  // generated background traffic (veh/h)
+  std::vector<double> demand_scales{1.0};           // a .sumocfg's own demand, times SUMO's --scale
+  std::vector<EvRouting> routings{EvRouting::static_route, EvRouting::dynamic_route};
+  std::vector<EvSignals> signals{EvSignals::none, EvSignals::bluelight, EvSignals::corridor,
+                                 EvSignals::corridor_bluelight};
   std::uint32_t seeds = 10;
   std::uint64_t first_seed = 1;
   std::filesystem::path out_dir;
   double demand_end_s = 900.0;
-  double ev_depart_s = 300.0;
-  double end_s = 2400.0;
+  double ev_depart_s = 300.0;  // after the scenario's begin
+  // After the scenario's begin; unset: a .sumocfg's own end, else 2400 s.
+  std::optional<double> end_s;
   double congestion_period_s = 10.0;
   std::uint32_t incidents = 2;
   unsigned parallel = 2;
   SumoBackend backend = SumoBackend::traci;
 };
 
-struct ExperimentRow {
-  EvRouting routing;
-  EvSignals signals;
-  double volume;
-  std::uint64_t seed;
+// One run's identity and result: what `corridor sim --result FILE` writes and what is collected.
+struct RunRecord {
+  std::string scenario;
+  bool with_ev = true;
+  EvRouting routing = EvRouting::dynamic_route;
+  EvSignals signals = EvSignals::corridor;
+  double volume = 0.0;        // generated background veh/h; 0 for a scenario's own demand
+  double demand_scale = 1.0;  // SUMO's --scale
+  std::uint64_t seed = 1;
+  std::string ev_from;
+  std::string ev_to;
+  double ev_depart_s = 0.0;  // simulation time
   ClosedLoopResult result;
+};
+nlohmann::json to_json_record(const RunRecord& r);
+// Throws SimError naming `source` for a record that is not one.
+RunRecord record_from_json(const nlohmann::json& j, const std::string& source);
+
+struct ExperimentRow {
+  RunRecord run;
   double baseline_time_loss_s;
   [[nodiscard]] double others_delay_rel() const;
+  [[nodiscard]] double ev_time_s() const;  // travel time, or the time it was still driving
 };
 
-// Runs the matrix and writes sumo_runs.csv, sumo_summary.csv, sumo_summary.md and the plots into
-// out_dir. Returns the rows, sorted by volume, seed, routing and signals.
+// Runs the matrix here and writes sumo_runs.csv, sumo_summary.csv, sumo_summary.md and the plots
+// into out_dir. Returns the rows, sorted by demand, seed, routing and signals.
 std::vector<ExperimentRow> run_sumo_experiment(const SumoExperimentOptions& options);
+
+// Plans the matrix (nets and generated demand are built now, so that runs write only their own
+// directories) and writes one `corridor sim` command line per run to `jobs_file`. Paths are
+// absolute: run the lines on hosts that see the same paths. Returns the number of lines.
+std::size_t emit_sumo_jobs(const SumoExperimentOptions& options, const std::filesystem::path& jobs_file,
+                           const std::filesystem::path& corridor_binary);
+
+// Reads every *.run.json under `dirs` and writes the CSVs, the summary and the plots into out_dir.
+// Throws SimError when there is no record, when a run has no baseline, or when records disagree
+// on their scenario.
+std::vector<ExperimentRow> collect_sumo_experiment(const std::vector<std::filesystem::path>& dirs,
+                                                   const std::filesystem::path& out_dir);
 
 }  // namespace corridor::sim

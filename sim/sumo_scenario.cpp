@@ -4,11 +4,20 @@
 
 namespace corridor::sim {
 
-std::unique_ptr<SumoScenario> load_sumo_scenario(const std::string& name, const std::filesystem::path& dir,
-                                                 const std::filesystem::path& net_file) {
-  maps::SumoNet net = maps::read_sumo_net(net_file);
+std::unique_ptr<SumoScenario> load_sumo_scenario(const ScenarioNet& scenario_net) {
+  maps::SumoNet net = maps::read_sumo_net(scenario_net.net);
+  if (scenario_net.config) {
+    for (const auto& file : scenario_net.config->additional_files) {
+      for (maps::SumoTlLogic& logic : maps::read_sumo_tl_logics(file)) {
+        std::erase_if(net.tl_logics, [&](const maps::SumoTlLogic& l) { return l.id == logic.id; });
+        net.tl_logics.push_back(std::move(logic));
+      }
+    }
+  }
   maps::SumoGraph graph = maps::build_sumo_graph(net);
-  auto s = std::unique_ptr<SumoScenario>(new SumoScenario{name, dir, net_file, std::move(net), std::move(graph), {}, {}, {}, {}});
+  auto s = std::unique_ptr<SumoScenario>(new SumoScenario{scenario_net.name, scenario_net.dir, scenario_net.net,
+                                                          std::move(net), std::move(graph), {}, {}, {}, {},
+                                                          scenario_net.config});
   s->sumo_plans = maps::sumo_signal_plans(s->net);
   std::unordered_map<NodeId, std::size_t> tls_of;
   s->plans = maps::plans_by_node(s->graph, s->net, s->sumo_plans, &tls_of);

@@ -9,6 +9,7 @@
 
 #include "maps/sumo_graph.hpp"
 #include "maps/sumo_net.hpp"
+#include "sim/scenario_builder.hpp"
 
 namespace corridor::sim {
 
@@ -22,10 +23,12 @@ struct SumoScenario {
   std::unordered_map<NodeId, maps::SignalPlan> plans;
   std::unordered_map<NodeId, const maps::SumoSignalPlan*> sumo_plan_of;
   std::unordered_map<std::string, std::vector<maps::SumoTlPhase>> tls_phases;
+  std::optional<SumoConfig> config;  // a user's scenario: SUMO runs its configuration
 };
 
-// Throws MapLoadError / SimError for an unreadable or unusable net.
-std::unique_ptr<SumoScenario> load_sumo_scenario(const std::string& name, const std::filesystem::path& dir,
-                                                 const std::filesystem::path& net_file);
+// Throws MapLoadError / SimError for an unreadable or unusable net. With a configuration, the
+// traffic-light programs of its additional files replace the net's (SUMO runs the last program
+// loaded for a light), so that the normal programs preemption restores are the scenario's own.
+std::unique_ptr<SumoScenario> load_sumo_scenario(const ScenarioNet& net);
 
 }  // namespace corridor::sim

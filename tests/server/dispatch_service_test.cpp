@@ -9,8 +9,10 @@
 #include <random>
 #include <thread>
 
+#include "maps/intersection_geometry.hpp"
 #include "maps/synthetic_grid.hpp"
 #include "planner/one_to_one_search.hpp"
+#include "preemption/signal_costs.hpp"
 #include "tests/server/temp_db.hpp"
 
 namespace corridor::server {
@@ -68,6 +70,8 @@ TEST(DispatchService, CreatesAMissionWithRouteEtaAndPreemptionSchedule) {
   // The service's route is the optimal one (Dijkstra oracle with the same costs).
   planner::CostOverlay overlay(grid());
   overlay.set_signal_delay(grid(), DispatchConfig{}.signal_delay_s);
+  // Lights with a plan cost their expected transition: the service preempts them.
+  preemption::set_signal_costs(overlay, maps::default_signal_plans(grid()), preemption::SignalCostRule::preempted);
   const planner::TravelCost cost(grid(), overlay, {120.0 / 3.6});
   planner::OneToOneSearch dijkstra;
   const auto oracle = dijkstra.run(planner::SearchSpace(cost, {m.route.start}, {m.route.goal}), false);
@@ -243,6 +247,8 @@ TEST(DispatchService, ConcurrentReportsKeepEveryPlanOptimal) {
 
   planner::CostOverlay overlay(grid());
   overlay.set_signal_delay(grid(), DispatchConfig{}.signal_delay_s);
+  // Lights with a plan cost their expected transition: the service preempts them.
+  preemption::set_signal_costs(overlay, maps::default_signal_plans(grid()), preemption::SignalCostRule::preempted);
   for (const auto& [e, f] : final_factor) overlay.set_edge(e, {f, 0.0});
   const planner::TravelCost cost(grid(), overlay, {120.0 / 3.6});
   planner::OneToOneSearch dijkstra;
@@ -371,6 +377,8 @@ TEST(DispatchService, PersistsAndResumesActiveMissionsAfterRestart) {
   // Congestion still in force applies to the resumed planner.
   planner::CostOverlay overlay(grid());
   overlay.set_signal_delay(grid(), DispatchConfig{}.signal_delay_s);
+  // Lights with a plan cost their expected transition: the service preempts them.
+  preemption::set_signal_costs(overlay, maps::default_signal_plans(grid()), preemption::SignalCostRule::preempted);
   overlay.set_edge(congested[0], {7.0, 0.0});
   const planner::TravelCost cost(grid(), overlay, {120.0 / 3.6});
   planner::OneToOneSearch dijkstra;

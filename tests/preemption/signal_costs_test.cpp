@@ -1,0 +1,133 @@
+// The route cost of a signal: E[Trans] and the mean red wait against a sampled timeline of the
+// normal cycle, on hand-made and random plans; and the overlay gets the rule's value per plan.
+#include "preemption/signal_costs.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "maps/synthetic_grid.hpp"
+#include "preemption/timing.hpp"
+#include "tests/preemption/random_plans.hpp"
+
+namespace corridor::preemption {
+namespace {
+
+// One cycle as segments: each program step's green, then its clearance (yellow + all-red). A
+// movement is green in a clearance only when both neighbouring steps serve it.
+struct Segment {
+  double start, end;
+  std::size_t step;
+  bool clearance;
+};
+
+std::vector<Segment> timeline(const maps::SignalPlan& plan) {
+  std::vector<Segment> out;
+  double t = 0.0;
+  for (std::size_t k = 0; k < plan.program.size(); ++k) {
+    out.push_back({t, t + plan.program[k].green_s, k, false});
+    t += plan.program[k].green_s;
+    out.push_back({t, t + plan.yellow_s + plan.all_red_s, k, true});
+    t += plan.yellow_s + plan.all_red_s;
+  }
+  return out;
+}
+
+bool green(const maps::SignalPlan& plan, const Segment& s, std::size_t movement) {
+  const auto serves = [&](std::size_t k) { return plan.phases[plan.program[k].phase].serves(movement); };
+  if (!s.clearance) return serves(s.step);
+  return serves(s.step) && serves((s.step + 1) % plan.program.size());
+}
+
+// Sampled averages over arrivals every dt seconds of the cycle.
+double sampled_transition(const maps::SignalPlan& plan, double dt) {
+  double sum = 0.0;
+  int n = 0;
+  for (const Segment& s : timeline(plan)) {
+    for (double u = s.start + dt / 2; u < s.end; u += dt, ++n) {
+      const double x = u - s.start;
+      const double min_green = plan.phases[plan.program[s.step].phase].min_green_s;
+      sum += s.clearance ? plan.yellow_s + plan.all_red_s - x : transition_time_s(min_green - x, plan.yellow_s, plan.all_red_s);
+    }
+  }
+  return sum / n;
+}
+
+double sampled_red_wait(const maps::SignalPlan& plan, double dt) {
+  const auto one = timeline(plan);
+  const double cycle = plan.cycle_s();
+  double total = 0.0;
+  for (std::size_t i = 0; i < plan.movements.size(); ++i) {
+    std::vector<Segment> two = one;  // two cycles, to find the next green after the first
+    for (Segment s : one) two.push_back({s.start + cycle, s.end + cycle, s.step, s.clearance});
+    double sum = 0.0;
+    int n = 0;
+    for (double u = dt / 2; u < cycle; u += dt, ++n) {
+      double wait = cycle;  // never green
+      for (const Segment& s : two) {
+        if (s.end <= u || !green(plan, s, i) || s.end - s.start <= 0.0) continue;
+        wait = std::max(0.0, s.start - u);
+        break;
+      }
+      sum += wait;
+    }
+    total += sum / n;
+  }
+  return total / static_cast<double>(plan.movements.size());
+}
+
+maps::SignalPlan two_phase_plan() {
+  maps::SignalPlan plan;
+  plan.node = NodeId{3};
+  plan.movements = {{maps::Compass::north, maps::Compass::south, maps::Turn::through, 0},
+                    {maps::Compass::east, maps::Compass::west, maps::Turn::through, 0}};
+  plan.conflict = {0, 1, 1, 0};
+  plan.phases = {{"NS", {1, 0}, 8.0}, {"EW", {0, 1}, 8.0}};
+  plan.program = {{0, 30.0}, {1, 20.0}};
+  plan.yellow_s = 3.0;
+  plan.all_red_s = 2.0;
+  return plan;
+}
+
+TEST(SignalCosts, TwoPhasePlanByHand) {
+  const auto plan = two_phase_plan();  // cycle 30 + 5 + 20 + 5 = 60 s
+  // Greens: 8²/2 + 30·5 + 5²/2 = 194.5 and 8²/2 + 20·5 + 5²/2 = 144.5, over 60 s.
+  EXPECT_NEAR(expected_transition_s(plan), (194.5 + 144.5) / 60.0, 1e-12);
+  // N-S is red 30 s a cycle, E-W 40 s: (30² + 40²) / (2 · 60) / 2.
+  EXPECT_NEAR(expected_red_delay_s(plan), (900.0 / 120.0 + 1600.0 / 120.0) / 2.0, 1e-12);
+}
+
+TEST(SignalCosts, ClosedFormsMatchASampledCycleOnRandomPlans) {
+  std::mt19937_64 rng(11);
+  for (int k = 0; k < 60; ++k) {
+    const auto plan = testing::random_plan(rng, NodeId{static_cast<std::uint32_t>(k)});
+    SCOPED_TRACE(k);
+    EXPECT_NEAR(expected_transition_s(plan), sampled_transition(plan, 0.01), 0.01);
+    EXPECT_NEAR(expected_red_delay_s(plan), sampled_red_wait(plan, 0.01), 0.02);
+    // Preempting a light never costs more than its minimum green plus clearance.
+    double worst = 0.0;
+    for (const auto& p : plan.phases) worst = std::max(worst, p.min_green_s);
+    EXPECT_LE(expected_transition_s(plan), worst + plan.yellow_s + plan.all_red_s + 1e-9);
+  }
+}
+
+TEST(SignalCosts, OverlayGetsEachPlansValueByTheRule) {
+  maps::GridSpec spec;
+  spec.rows = spec.cols = 3;
+  const maps::RoadGraph graph = maps::make_perturbed_grid(spec);
+  std::unordered_map<NodeId, maps::SignalPlan> plans;
+  auto plan = two_phase_plan();
+  plan.node = NodeId{1};
+  plans.emplace(NodeId{1}, plan);
+  planner::CostOverlay overlay(graph);
+  set_signal_costs(overlay, plans, SignalCostRule::preempted);
+  EXPECT_DOUBLE_EQ(overlay.node_delay_s(NodeId{1}), expected_transition_s(plan));
+  EXPECT_DOUBLE_EQ(overlay.node_delay_s(NodeId{0}), 0.0);
+  set_signal_costs(overlay, plans, SignalCostRule::normal);
+  EXPECT_DOUBLE_EQ(overlay.node_delay_s(NodeId{1}), expected_red_delay_s(plan));
+  // A preempted light costs less than waiting out its red.
+  EXPECT_LT(expected_transition_s(plan), expected_red_delay_s(plan));
+}
+
+}  // namespace
+}  // namespace corridor::preemption
