@@ -39,9 +39,9 @@ void write_ev_types(const std::filesystem::path& file, double vmax_mps) {
   std::ofstream out(file, std::ios::trunc);
   // The EV drives at the speed limit (speedFactor 1), like the planner's cost model, up to vmax.
   // The bluelight type may pass red lights slowly, as SUMO users configure it. With Corridor's
-  // preemption as well (corridor+bluelight), the EV keeps the device (others make way) but waits at
-  // a red: SUMO's other drivers do not yield to a vehicle crossing on red, so red running collides
-  // in the junction, and the preemption is there to turn that red green in time.
+  // preemption as well (corridor+bluelight) the EV keeps the device (others make way) without the
+  // red-running junction parameters, since the preemption is there to turn the red green. SUMO's
+  // device still lets it pass a red by design, and SUMO's other drivers do not yield to it there.
   out << fmt::format(
       "<additional>\n"
       "  <vType id=\"ev\" vClass=\"emergency\" guiShape=\"emergency\" color=\"1,0,0\" maxSpeed=\"{0:.3f}\" "
