@@ -1,0 +1,112 @@
+// Collecting run records into the experiment's tables: each run is paired with the baseline of its
+// demand and seed, the median and IQR come out of the records, a failed or unpaired run is listed
+// and left out, and records of two scenarios are refused.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <fstream>
+
+#include "sim/errors.hpp"
+#include "sim/sumo_experiment.hpp"
+
+namespace corridor::sim {
+namespace {
+
+namespace fs = std::filesystem;
+
+class SumoCollectTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("sumo-collect-" + std::to_string(::getpid()) + "-" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_ / "runs" / "a");
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  void add(const std::string& name, bool with_ev, EvSignals signals, std::uint64_t seed, double travel, double others_loss,
+           const std::string& scenario = "town") {
+    RunRecord r;
+    r.scenario = scenario;
+    r.with_ev = with_ev;
+    r.routing = EvRouting::dynamic_route;
+    r.signals = signals;
+    r.demand_scale = 1.5;
+    r.seed = seed;
+    r.ev_depart_s = 100.0;
+    r.result.ev_arrived = true;
+    r.result.ev_travel_time_s = travel;
+    r.result.others_mean_time_loss_s = others_loss;
+    r.result.end_time_s = 900.0;
+    std::ofstream(dir_ / "runs" / "a" / (name + ".run.json")) << to_json_record(r).dump();
+  }
+  std::string read(const std::string& name) {
+    std::ifstream in(dir_ / "out" / name);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  }
+  fs::path dir_;
+};
+
+TEST_F(SumoCollectTest, PairsBaselinesAndSummarizesMediansAndIqr) {
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    add("b" + std::to_string(seed), false, EvSignals::none, seed, 0.0, 50.0);
+    add("c" + std::to_string(seed), true, EvSignals::corridor, seed, 100.0 * seed, 50.0 + seed);
+  }
+  const auto rows = collect_sumo_experiment({dir_ / "runs"}, dir_ / "out");
+  ASSERT_EQ(rows.size(), 3u);
+  EXPECT_DOUBLE_EQ(rows[1].baseline_time_loss_s, 50.0);
+  EXPECT_NEAR(rows[1].others_delay_rel(), 2.0 / 50.0, 1e-12);
+  // Median 200, quartiles 150 and 250 (linear interpolation), 3 of 3 arrived.
+  EXPECT_NE(read("sumo_summary.csv").find("dynamic,corridor,0,3,3,200.0,150.0,250.0"), std::string::npos)
+      << read("sumo_summary.csv");
+  EXPECT_NE(read("sumo_summary.md").find("demand x1.5"), std::string::npos);
+  const std::string runs = read("sumo_runs.csv");
+  EXPECT_EQ(std::count(runs.begin(), runs.end(), '\n'), 4);
+}
+
+TEST_F(SumoCollectTest, FailedAndUnpairedRunsAreListedAndLeftOut) {
+  add("b1", false, EvSignals::none, 1, 0.0, 40.0);
+  add("c1", true, EvSignals::corridor, 1, 120.0, 41.0);
+  add("c2", true, EvSignals::corridor, 2, 130.0, 41.0);  // seed 2 has no baseline
+  std::ofstream(dir_ / "runs" / "a" / "crashed.run.json") << R"({"error": "SUMO connection lost"})";
+  std::ofstream(dir_ / "runs" / "a" / "half.run.json") << R"({"scenario": "town", "with_)";
+  const auto rows = collect_sumo_experiment({dir_ / "runs"}, dir_ / "out");
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0].run.seed, 1u);
+  const std::string md = read("sumo_summary.md");
+  EXPECT_NE(md.find("3 run(s) left out"), std::string::npos) << md;
+  EXPECT_NE(md.find("SUMO connection lost"), std::string::npos);
+  EXPECT_NE(md.find("no baseline"), std::string::npos);
+}
+
+TEST_F(SumoCollectTest, RefusesMixedScenariosAndNothingToCollect) {
+  EXPECT_THROW(collect_sumo_experiment({dir_ / "runs"}, dir_ / "out"), SimError);
+  EXPECT_THROW(collect_sumo_experiment({dir_ / "nowhere"}, dir_ / "out"), SimError);
+  add("b1", false, EvSignals::none, 1, 0.0, 40.0, "town");
+  add("c1", true, EvSignals::corridor, 1, 120.0, 41.0, "city");
+  EXPECT_THROW(collect_sumo_experiment({dir_ / "runs"}, dir_ / "out"), SimError);
+}
+
+TEST(RunRecord, RoundTripsAndRejectsWhatIsNotOne) {
+  RunRecord r;
+  r.scenario = "x";
+  r.signals = EvSignals::corridor_bluelight;
+  r.routing = EvRouting::static_route;
+  r.volume = 400.0;
+  r.seed = 7;
+  r.result.ev_stops = 2;
+  const RunRecord back = record_from_json(to_json_record(r), "mem");
+  EXPECT_EQ(back.signals, EvSignals::corridor_bluelight);
+  EXPECT_EQ(back.routing, EvRouting::static_route);
+  EXPECT_EQ(back.seed, 7u);
+  EXPECT_EQ(back.result.ev_stops, 2);
+  EXPECT_EQ(to_json_record(r)["signals"], "corridor+bluelight");
+  auto j = to_json_record(r);
+  j["signals"] = "sirens";
+  EXPECT_THROW(record_from_json(j, "mem"), SimError);
+  EXPECT_THROW(record_from_json(nlohmann::json::array(), "mem"), SimError);
+  EXPECT_THROW(record_from_json(nlohmann::json{{"scenario", 3}}, "mem"), SimError);
+}
+
+}  // namespace
+}  // namespace corridor::sim
