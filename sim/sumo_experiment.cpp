@@ -239,7 +239,8 @@ std::vector<ExperimentRow> run_sumo_experiment(const SumoExperimentOptions& o) {
   // Only this matrix's records: an output directory reused for another matrix keeps its old files.
   std::vector<std::filesystem::path> files;
   for (const PlannedRun& r : plan.runs) files.push_back(r.result_file);
-  return collect_sumo_experiment(files, o.out_dir);
+  // A run whose process died (SUMO can abort inside libsumo) left no file: listed, not fatal.
+  return collect_run_files(files, o.out_dir);
 }
 
 std::size_t emit_sumo_jobs(const SumoExperimentOptions& o, const std::filesystem::path& jobs_file,
@@ -296,6 +297,10 @@ std::vector<ExperimentRow> collect_sumo_experiment(const std::vector<std::filesy
       if (entry.is_regular_file() && entry.path().filename().string().ends_with(".run.json")) files.push_back(entry.path());
     }
   }
+  return collect_run_files(files, out_dir);
+}
+
+std::vector<ExperimentRow> collect_run_files(std::vector<std::filesystem::path> files, const std::filesystem::path& out_dir) {
   std::sort(files.begin(), files.end());
   files.erase(std::unique(files.begin(), files.end()), files.end());
 
@@ -305,6 +310,7 @@ std::vector<ExperimentRow> collect_sumo_experiment(const std::vector<std::filesy
     std::ifstream in(f);
     nlohmann::json j;
     try {
+      if (!in) throw SimError(f.string() + ": no result (the run ended without one; see its .console.log and .sumo.log)");
       in >> j;
       records.push_back(record_from_json(j, f.string()));
     } catch (const nlohmann::json::exception&) {

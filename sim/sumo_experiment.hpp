@@ -82,4 +82,8 @@ std::size_t emit_sumo_jobs(const SumoExperimentOptions& options, const std::file
 std::vector<ExperimentRow> collect_sumo_experiment(const std::vector<std::filesystem::path>& dirs,
                                                    const std::filesystem::path& out_dir);
 
+// The same from a list of record files; a file that is missing or is not a record is listed in the
+// summary as a failed run and left out.
+std::vector<ExperimentRow> collect_run_files(std::vector<std::filesystem::path> files, const std::filesystem::path& out_dir);
+
 }  // namespace corridor::sim

@@ -70,11 +70,15 @@ TEST_F(SumoCollectTest, FailedAndUnpairedRunsAreListedAndLeftOut) {
   add("c2", true, EvSignals::corridor, 2, 130.0, 41.0);  // seed 2 has no baseline
   std::ofstream(dir_ / "runs" / "a" / "crashed.run.json") << R"({"error": "SUMO connection lost"})";
   std::ofstream(dir_ / "runs" / "a" / "half.run.json") << R"({"scenario": "town", "with_)";
-  const auto rows = collect_sumo_experiment({dir_ / "runs"}, dir_ / "out");
+  auto files = std::vector<fs::path>{};
+  for (const auto& e : fs::directory_iterator(dir_ / "runs" / "a")) files.push_back(e.path());
+  files.push_back(dir_ / "runs" / "a" / "aborted.run.json");  // planned, but its process died
+  const auto rows = collect_run_files(files, dir_ / "out");
   ASSERT_EQ(rows.size(), 1u);
   EXPECT_EQ(rows[0].run.seed, 1u);
   const std::string md = read("sumo_summary.md");
-  EXPECT_NE(md.find("3 run(s) left out"), std::string::npos) << md;
+  EXPECT_NE(md.find("4 run(s) left out"), std::string::npos) << md;
+  EXPECT_NE(md.find("aborted.run.json: no result"), std::string::npos) << md;
   EXPECT_NE(md.find("SUMO connection lost"), std::string::npos);
   EXPECT_NE(md.find("no baseline"), std::string::npos);
 }
