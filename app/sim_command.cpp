@@ -4,7 +4,6 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
-#include <cmath>
 #include <optional>
 #include <cstdlib>
 #include <fstream>
@@ -49,8 +48,7 @@ struct SimOptions {
 };
 
 sim::EvRouting parse_routing(const std::string& s) {
-  if (s == "static") return sim::EvRouting::static_route;
-  if (s == "dynamic") return sim::EvRouting::dynamic_route;
+  if (const auto routing = sim::parse_ev_routing(s)) return *routing;
   throw UsageError("--routing must be static or dynamic, got '" + s + "'");
 }
 
@@ -207,35 +205,6 @@ void register_sim_command(CLI::App& app) {
 
 namespace {
 
-std::vector<std::string> split_commas(const std::string& text) {
-  std::vector<std::string> items;
-  std::string item;
-  for (std::size_t i = 0; i <= text.size(); ++i) {
-    if (i == text.size() || text[i] == ',') {
-      items.push_back(item);
-      item.clear();
-    } else {
-      item += text[i];
-    }
-  }
-  return items;
-}
-
-std::vector<double> parse_numbers(const std::string& option, const std::string& text) {
-  std::vector<double> out;
-  for (const std::string& item : split_commas(text)) {
-    try {
-      std::size_t used = 0;
-      const double v = std::stod(item, &used);
-      if (used != item.size() || !std::isfinite(v)) throw std::invalid_argument(item);
-      out.push_back(v);
-    } catch (const std::exception&) {
-      throw UsageError(option + " expects numbers separated by commas, such as 1,1.5; got '" + text + "'");
-    }
-  }
-  return out;
-}
-
 // The path of this executable, for emitted command lines that run it again.
 std::filesystem::path self_binary() {
   std::error_code ec;
@@ -247,10 +216,9 @@ std::filesystem::path self_binary() {
 
 void register_sumo_experiment(CLI::App& experiment) {
   auto o = std::make_shared<sim::SumoExperimentOptions>();
-  auto volumes = std::make_shared<std::string>("200,400,600,800");
-  auto scales = std::make_shared<std::string>("1");
-  auto signals = std::make_shared<std::string>("none,bluelight,corridor,corridor+bluelight");
-  auto routings = std::make_shared<std::string>("static,dynamic");
+  auto signals = std::make_shared<std::vector<std::string>>(
+      std::vector<std::string>{"none", "bluelight", "corridor", "corridor+bluelight"});
+  auto routings = std::make_shared<std::vector<std::string>>(std::vector<std::string>{"static", "dynamic"});
   auto emit_jobs = std::make_shared<std::string>();
   auto collect = std::make_shared<std::vector<std::string>>();
   auto end_s = std::make_shared<std::optional<double>>();
@@ -258,12 +226,14 @@ void register_sumo_experiment(CLI::App& experiment) {
       "sumo", "Closed-loop SUMO matrix: routing x signal strategies over demand levels and seeds; run here, or emit and collect");
   cmd->add_option("--scenario", o->scenario, "grid, a SUMO configuration (.sumocfg), a .net.xml, or an OSM file")
       ->capture_default_str();
-  cmd->add_option("--volumes", *volumes, "generated scenarios: background volumes, vehicles/hour, comma-separated")
+  cmd->add_option("--volumes", o->volumes, "generated scenarios: background volumes, vehicles/hour, comma-separated")
+      ->delimiter(',')
       ->capture_default_str();
-  cmd->add_option("--demand-scale", *scales, "a .sumocfg's own demand times these (SUMO's --scale), comma-separated")
+  cmd->add_option("--demand-scale", o->demand_scales, "a .sumocfg's own demand times these (SUMO's --scale), comma-separated")
+      ->delimiter(',')
       ->capture_default_str();
-  cmd->add_option("--signals", *signals, "signal strategies, comma-separated")->capture_default_str();
-  cmd->add_option("--routings", *routings, "EV routing, comma-separated")->capture_default_str();
+  cmd->add_option("--signals", *signals, "signal strategies, comma-separated")->delimiter(',')->capture_default_str();
+  cmd->add_option("--routings", *routings, "EV routing, comma-separated")->delimiter(',')->capture_default_str();
   cmd->add_option("--seeds", o->seeds, "seeds per demand level")->capture_default_str();
   cmd->add_option("--first-seed", o->first_seed, "seeds are first-seed, first-seed+1, ...")->capture_default_str();
   cmd->add_option("--out", o->out_dir, "output directory (runs, tables and plots)")->required();
@@ -281,7 +251,7 @@ void register_sumo_experiment(CLI::App& experiment) {
       ->expected(1, -1);
   auto libsumo = std::make_shared<bool>(false);
   cmd->add_flag("--libsumo", *libsumo, "run SUMO inside each run's process (libsumo) instead of over TraCI");
-  cmd->callback([o, volumes, scales, signals, routings, emit_jobs, collect, end_s, libsumo] {
+  cmd->callback([o, signals, routings, emit_jobs, collect, end_s, libsumo] {
     if (!emit_jobs->empty() && !collect->empty()) throw UsageError("--emit-jobs and --collect are two steps: give one");
     if (!collect->empty()) {
       std::vector<std::filesystem::path> dirs(collect->begin(), collect->end());
@@ -291,13 +261,11 @@ void register_sumo_experiment(CLI::App& experiment) {
       return;
     }
     o->backend = *libsumo ? sim::SumoBackend::libsumo : sim::SumoBackend::traci;
-    o->volumes = parse_numbers("--volumes", *volumes);
-    o->demand_scales = parse_numbers("--demand-scale", *scales);
     o->end_s = *end_s;
     o->signals.clear();
-    for (const std::string& s : split_commas(*signals)) o->signals.push_back(parse_signals(s));
+    for (const std::string& s : *signals) o->signals.push_back(parse_signals(s));
     o->routings.clear();
-    for (const std::string& r : split_commas(*routings)) o->routings.push_back(parse_routing(r));
+    for (const std::string& r : *routings) o->routings.push_back(parse_routing(r));
     if (o->seeds == 0 || o->seeds > 1000) throw UsageError("--seeds must be in [1, 1000]");
     if (o->parallel == 0 || o->parallel > 64) throw UsageError("--parallel must be in [1, 64]");
     if (o->end_s && !(*o->end_s > o->ev_depart_s)) throw UsageError("--end-s must come after --ev-depart-s");

@@ -180,6 +180,13 @@ const char* to_string(EvSignals s) {
   return "?";
 }
 
+std::optional<EvRouting> parse_ev_routing(const std::string& text) {
+  for (EvRouting r : {EvRouting::static_route, EvRouting::dynamic_route}) {
+    if (text == to_string(r)) return r;
+  }
+  return std::nullopt;
+}
+
 std::optional<EvSignals> parse_ev_signals(const std::string& text) {
   for (EvSignals s : {EvSignals::none, EvSignals::bluelight, EvSignals::corridor, EvSignals::corridor_bluelight}) {
     if (text == to_string(s)) return s;

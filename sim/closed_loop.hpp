@@ -25,7 +25,8 @@ enum class SumoBackend { traci, libsumo };
 enum class EvSignals { none, bluelight, corridor, corridor_bluelight };
 const char* to_string(EvRouting r);
 const char* to_string(EvSignals s);  // "none", "bluelight", "corridor", "corridor+bluelight"
-// The inverse of to_string; nullopt for anything else.
+// The inverses of to_string; nullopt for anything else.
+std::optional<EvRouting> parse_ev_routing(const std::string& text);
 std::optional<EvSignals> parse_ev_signals(const std::string& text);
 [[nodiscard]] inline bool preempts(EvSignals s) { return s == EvSignals::corridor || s == EvSignals::corridor_bluelight; }
 [[nodiscard]] inline bool has_bluelight(EvSignals s) { return s == EvSignals::bluelight || s == EvSignals::corridor_bluelight; }

@@ -30,7 +30,8 @@ void check_net_readable(const std::filesystem::path& net) {
   } catch (const std::exception& e) {
     throw SimError(e.what());
   }
-  check_net_version(net, version, installed_sumo_version());
+  // Old nets carry no version, and SUMO reads them: no need to ask SUMO for its own.
+  if (!version.empty()) check_net_version(net, version, installed_sumo_version());
 }
 
 bool up_to_date(const std::filesystem::path& out, const std::filesystem::path& input) {

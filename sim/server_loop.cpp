@@ -179,7 +179,7 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
         if (pos && config.gps_noise_m > 0.0 && !road.empty() && sumo_angle >= 0.0 && sumo_angle <= 360.0) {
           // The receiver and the onboard localizer: odometry every step, a fix at the GPS rate.
           const maps::Point2 truth{pos->x, pos->y};
-          const double angle = as_double(ev, libsumo::VAR_ANGLE);
+          const double angle = sumo_angle;
           if (last_truth) onboard.on_odometry(odometry.step(t, last_truth->first, last_truth->second, truth, angle));
           last_truth = {truth, angle};
           const double since = t - ev_depart;

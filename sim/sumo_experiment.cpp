@@ -185,9 +185,9 @@ RunRecord record_from_json(const nlohmann::json& j, const std::string& source) {
     RunRecord r;
     r.scenario = j.at("scenario").get<std::string>();
     r.with_ev = j.at("with_ev").get<bool>();
-    const std::string routing = j.at("routing").get<std::string>();
-    if (routing != "static" && routing != "dynamic") throw SimError("unknown routing '" + routing + "'");
-    r.routing = routing == "static" ? EvRouting::static_route : EvRouting::dynamic_route;
+    const auto routing = parse_ev_routing(j.at("routing").get<std::string>());
+    if (!routing) throw SimError("unknown routing '" + j.at("routing").get<std::string>() + "'");
+    r.routing = *routing;
     const auto signals = parse_ev_signals(j.at("signals").get<std::string>());
     if (!signals) throw SimError("unknown signals '" + j.at("signals").get<std::string>() + "'");
     r.signals = *signals;

@@ -8,6 +8,7 @@
 
 #include "sim/errors.hpp"
 #include "sim/sumo_experiment.hpp"
+#include "tests/sim/temp_dir.hpp"
 
 namespace corridor::sim {
 namespace {
@@ -16,13 +17,7 @@ namespace fs = std::filesystem;
 
 class SumoCollectTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("sumo-collect-" + std::to_string(::getpid()) + "-" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_ / "runs" / "a");
-  }
-  void TearDown() override { fs::remove_all(dir_); }
+  void SetUp() override { fs::create_directories(dir_ / "runs" / "a"); }
 
   void add(const std::string& name, bool with_ev, EvSignals signals, std::uint64_t seed, double travel, double others_loss,
            const std::string& scenario = "town") {
@@ -44,7 +39,8 @@ class SumoCollectTest : public ::testing::Test {
     std::ifstream in(dir_ / "out" / name);
     return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
   }
-  fs::path dir_;
+  testing::TempDir tmp_{"sumo-collect"};
+  const fs::path& dir_ = tmp_.path();
 };
 
 TEST_F(SumoCollectTest, PairsBaselinesAndSummarizesMediansAndIqr) {

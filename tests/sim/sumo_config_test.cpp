@@ -9,6 +9,7 @@
 
 #include "maps/sumo_net.hpp"
 #include "sim/errors.hpp"
+#include "tests/sim/temp_dir.hpp"
 
 namespace corridor::sim {
 namespace {
@@ -18,13 +19,9 @@ namespace fs = std::filesystem;
 class SumoConfigTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("sumocfg-test-" + std::to_string(::getpid()) + "-" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
     fs::create_directories(dir_ / "sub");
     for (const char* f : {"sub/city.net.xml", "a.rou.xml", "b.rou.xml", "sub/tls.add.xml", "det.add.xml"}) write(f, "<x/>");
   }
-  void TearDown() override { fs::remove_all(dir_); }
   void write(const std::string& name, const std::string& text) { std::ofstream(dir_ / name) << text; }
   fs::path cfg(const std::string& body) {
     write("s.sumocfg", "<?xml version=\"1.0\"?>\n<configuration>\n" + body + "</configuration>\n");
@@ -38,7 +35,8 @@ class SumoConfigTest : public ::testing::Test {
     }
     return "";
   }
-  fs::path dir_;
+  testing::TempDir tmp_{"sumocfg-test"};
+  const fs::path& dir_ = tmp_.path();
 };
 
 TEST_F(SumoConfigTest, ReadsInputsRelativeToTheFileAndItsTimeWindow) {
