@@ -174,7 +174,7 @@ class Store::Checkpointer {
       std::lock_guard lock(mutex_);
       stopping_ = true;
     }
-    cv_.notify_one();
+    cv_.notify_all();
     thread_.join();
     sqlite3_close(db_);
   }
@@ -198,13 +198,16 @@ class Store::Checkpointer {
       std::lock_guard lock(mutex_);
       wanted_ = true;
     }
-    cv_.notify_one();
+    cv_.notify_all();
   }
   void restart(sqlite3* writer, int wal_frames) {
     {
-      std::lock_guard lock(mutex_);
-      held_ = true;  // no new PASSIVE starts; the one running finishes first
-      if (running_) return;  // the next commit tries again
+      // No new PASSIVE starts, and the one running finishes first: it copies the bulk. Waiting for
+      // it here, rather than leaving the RESTART to a later commit, is what bounds the WAL when the
+      // checkpoint thread is starved: a busy writer could otherwise commit past every retry.
+      std::unique_lock lock(mutex_);
+      held_ = true;
+      cv_.wait(lock, [&] { return !running_; });
     }
     spdlog::debug("event=wal_restart_checkpoint wal_frames={}", wal_frames);
     int frames = 0;
@@ -216,7 +219,7 @@ class Store::Checkpointer {
       std::lock_guard lock(mutex_);
       held_ = false;
     }
-    cv_.notify_one();
+    cv_.notify_all();
   }
   void loop() {
     std::unique_lock lock(mutex_);
@@ -232,6 +235,7 @@ class Store::Checkpointer {
       if (rc != SQLITE_OK && rc != SQLITE_BUSY) spdlog::warn("event=checkpoint_failed mode=passive error=\"{}\"", sqlite3_errmsg(db_));
       lock.lock();
       running_ = false;
+      cv_.notify_all();  // a writer may wait to RESTART
     }
   }
 
