@@ -18,6 +18,7 @@ struct ApproachMeasurement {
   std::optional<double> queue_veh;
   std::optional<double> occupancy;
   std::optional<double> speed_ratio;
+  std::optional<double> queue_m;  // standing queue, metres back from the stop line (vicinity rules only)
 };
 
 // Without any measurement the approach is taken as low congestion.

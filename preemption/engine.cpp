@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 #include "maps/intersection_geometry.hpp"
 
@@ -50,12 +51,14 @@ const char* to_string(EntryState s) {
   return "?";
 }
 
-std::vector<Crossing> signalized_crossings(const planner::Route& route,
+std::vector<Crossing> signalized_crossings(const maps::RoadGraph& graph, const planner::Route& route,
                                            const std::unordered_map<NodeId, maps::SignalPlan>& plans, double now_s) {
   std::vector<Crossing> out;
+  double distance = route.edges.empty() ? 0.0 : -route.start.offset_m;
   for (std::size_t i = 0; i < route.nodes.size() && i + 1 < route.edges.size(); ++i) {
+    distance += graph.length_m(route.edges[i]);
     if (plans.count(route.nodes[i]) == 0) continue;
-    out.push_back({route.nodes[i], route.edges[i], route.edges[i + 1], now_s + route.arrival_s[i]});
+    out.push_back({route.nodes[i], route.edges[i], route.edges[i + 1], now_s + route.arrival_s[i], std::max(0.0, distance)});
   }
   return out;
 }
@@ -69,7 +72,36 @@ void PreemptionEngine::log(double t, MissionId m, NodeId n, std::string kind, st
   events_.push_back({t, m, n, std::move(kind), std::move(detail)});
 }
 
-bool PreemptionEngine::time_entry(ScheduleEntry& e, const Crossing& c, double now_s) {
+std::optional<PreemptionEngine::VicinityStart> PreemptionEngine::vicinity_start(const Crossing& c, const Crossing* previous,
+                                                                                 double trans_s, double now_s) const {
+  const VicinityConfig& v = config_.vicinity;
+  if (!v.enabled) return std::nullopt;
+  const auto it = measurements_.find(c.node);
+  if (it == measurements_.end()) return std::nullopt;
+  const maps::Compass from = maps::approach_side(graph_, c.in_edge);
+  const std::optional<double> queue_m = it->second[static_cast<int>(from)].queue_m;
+  if (!queue_m || *queue_m < v.jam_spacing_m) return std::nullopt;  // no standing vehicle
+  // The queue discharges in t_q = l1 + h·n after its green (eq. 8's clearance, per lane).
+  const double clearance = queue_clearance_s(*queue_m / v.jam_spacing_m, config_.timing);
+  const double link_m = c.distance_m - (previous != nullptr ? previous->distance_m : 0.0);
+  const double link_s = c.arrival_s - (previous != nullptr ? previous->arrival_s : now_s);
+  // Upstream approach: the vehicle meets the queue's tail, not the stop line, so the queue must be
+  // moving by the time it reaches the tail: τ − (tail distance)/v instead of τ in eq. 5.
+  double tail_s = 0.0;
+  if (link_m > 0.0 && link_s > 0.0) tail_s = std::min(*queue_m, link_m) / (link_m / link_s);
+  VicinityStart best{c.arrival_s - tail_s - trans_s - config_.timing.safety_margin_s - clearance, false};
+  // Downstream link of the previous signal: a queue about to spill back into that junction blocks
+  // the vehicle's exit there, so this signal's outflow must be moving when the vehicle reaches the
+  // previous one.
+  if (previous != nullptr && link_m > 0.0 && *queue_m >= v.spillback_fraction * link_m) {
+    const double flush = previous->arrival_s - trans_s - config_.timing.safety_margin_s - clearance;
+    if (flush < best.start_s) best = {flush, true};
+  }
+  best.start_s = std::max({best.start_s, c.arrival_s - v.max_lead_s, now_s});
+  return best;
+}
+
+bool PreemptionEngine::time_entry(ScheduleEntry& e, const Crossing& c, const Crossing* previous, double now_s) {
   const maps::SignalPlan& plan = plans_.at(c.node);
   const maps::Compass from = maps::approach_side(graph_, c.in_edge);
   std::optional<std::size_t> movement;
@@ -97,6 +129,12 @@ bool PreemptionEngine::time_entry(ScheduleEntry& e, const Crossing& c, double no
   if (auto it = measurements_.find(c.node); it != measurements_.end()) measured = it->second[static_cast<int>(from)];
   if (queue != nullptr) measured.queue_veh = queue->queue_now(from);
   e.congestion = classify_congestion(measured, config_.congestion);
+  // A link about to spill back is flushed with every movement of its approach, whatever turns the
+  // queued vehicles make. The transition estimate for the rule is the worst case, a full Trans.
+  const double full_trans =
+      transition_time_s(controller_.remaining_min_green_s(c.node, now_s), plan.yellow_s, plan.all_red_s);
+  const std::optional<VicinityStart> vicinity = vicinity_start(c, previous, full_trans, now_s);
+  if (vicinity && vicinity->spillback) e.congestion = CongestionLevel::high;
   // Measured demand per movement (the queue on its approach) where detectors report it.
   std::vector<double> demand(plan.movements.size(), std::nan(""));
   if (auto it = queues_.find(c.node); it != queues_.end()) {
@@ -127,6 +165,11 @@ bool PreemptionEngine::time_entry(ScheduleEntry& e, const Crossing& c, double no
     clearance = queue_clearance_s(queue_at_arrival_veh(e.arrival_s, q, config_.timing), config_.timing);
   }
   e.natural_start_s = std::max(now_s, preemption_start_s(e.arrival_s, trans, clearance, config_.timing));
+  e.vicinity.clear();
+  if (vicinity && vicinity->start_s < e.natural_start_s) {
+    e.natural_start_s = vicinity->start_s;
+    e.vicinity = vicinity->spillback ? "spillback" : "approach_queue";
+  }
   if (e.state == EntryState::active) e.natural_start_s = std::min(e.natural_start_s, e.started_s);
   e.release_s = e.arrival_s + config_.release_after_arrival_s;
   return true;
@@ -245,7 +288,9 @@ void PreemptionEngine::update_route(MissionId mission, int priority, std::span<c
   auto& entries = missions_[mission];
   std::vector<NodeId> touched;
   std::vector<NodeId> on_route;
+  const Crossing* previous = nullptr;
   for (const Crossing& c : crossings) {
+    const Crossing* previous_crossing = std::exchange(previous, &c);
     if (plans_.count(c.node) == 0 || std::find(on_route.begin(), on_route.end(), c.node) != on_route.end()) continue;
     if (exhausted_.count({mission, c.node}) != 0) continue;
     on_route.push_back(c.node);
@@ -256,7 +301,7 @@ void PreemptionEngine::update_route(MissionId mission, int priority, std::span<c
     if (existing != nullptr) {
       const double before = existing->natural_start_s;
       existing->priority = priority;
-      if (!time_entry(*existing, c, now_s)) {
+      if (!time_entry(*existing, c, previous_crossing, now_s)) {
         finish(*existing, EntryState::cancelled, now_s, "reason=no_movement");
       } else if (std::abs(existing->natural_start_s - before) > 0.5) {
         log(now_s, mission, c.node, "retimed", "start_s=" + fmt_s(existing->natural_start_s) + " arrival_s=" + fmt_s(existing->arrival_s));
@@ -265,10 +310,11 @@ void PreemptionEngine::update_route(MissionId mission, int priority, std::span<c
       auto e = std::make_unique<ScheduleEntry>();
       e->mission = mission;
       e->priority = priority;
-      if (!time_entry(*e, c, now_s)) continue;
+      if (!time_entry(*e, c, previous_crossing, now_s)) continue;
       log(now_s, mission, c.node, "scheduled",
           "phase=" + e->phase.label + " start_s=" + fmt_s(e->natural_start_s) + " arrival_s=" + fmt_s(e->arrival_s) +
-              " congestion=" + (e->congestion == CongestionLevel::high ? "high" : "low"));
+              " congestion=" + (e->congestion == CongestionLevel::high ? "high" : "low") +
+              (e->vicinity.empty() ? "" : " vicinity=" + e->vicinity));
       nodes_[c.node].entries.push_back(e.get());
       entries.push_back(std::move(e));
     }
@@ -333,6 +379,12 @@ void PreemptionEngine::record_measurement(NodeId node, maps::Compass approach, s
   ApproachMeasurement& m = measurements_[node][static_cast<int>(approach)];
   m.occupancy = occupancy;
   m.speed_ratio = speed_ratio;
+}
+
+void PreemptionEngine::record_queue_length(NodeId node, maps::Compass approach, double queue_m) {
+  if (plans_.count(node) == 0) throw CountError("node " + std::to_string(node.v) + " has no signal");
+  if (!(queue_m >= 0.0 && std::isfinite(queue_m))) throw CountError("queue length must be a finite number of metres >= 0");
+  measurements_[node][static_cast<int>(approach)].queue_m = queue_m;
 }
 
 void PreemptionEngine::tick(double now_s) {

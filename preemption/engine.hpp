@@ -27,6 +27,21 @@ namespace corridor::preemption {
 
 using MissionId = std::uint64_t;
 
+// Vicinity-aware preemption (the seed's future work): queues near the route, not only the vehicle's
+// own approach, decide when a hold starts. Both rules need a measured standing queue
+// (record_queue_length); without one they change nothing, and with `enabled` false the engine is
+// the seed's route-only preemption.
+struct VicinityConfig {
+  bool enabled = false;
+  double jam_spacing_m = 7.5;       // metres of lane per queued vehicle
+  // A queue filling this share of the link from the previous signal on the route is about to spill
+  // back into that junction and block the vehicle's exit there.
+  double spillback_fraction = 0.6;
+  // No vicinity rule starts a hold more than this before the vehicle's arrival, so that an early
+  // hold stays far inside max_hold_s.
+  double max_lead_s = 90.0;
+};
+
 struct PreemptionConfig {
   TimingConfig timing;
   CongestionClassifierConfig congestion;
@@ -34,6 +49,7 @@ struct PreemptionConfig {
   double max_overrun_s = 60.0;           // a vehicle this late past its predicted arrival: expire
   double max_hold_s = 180.0;             // no hold lasts longer than this, whatever happens
   double release_grace_s = 15.0;         // an active hold this long past its planned release ends
+  VicinityConfig vicinity;
 };
 
 // One signalized intersection on a route.
@@ -42,10 +58,11 @@ struct Crossing {
   EdgeId in_edge;
   EdgeId out_edge;
   double arrival_s = 0;  // predicted arrival at the stop line, absolute time
+  double distance_m = 0;  // along the route from the vehicle to the stop line
 };
 
 // The signalized crossings of a planned route, with arrivals relative to `now_s`.
-std::vector<Crossing> signalized_crossings(const planner::Route& route,
+std::vector<Crossing> signalized_crossings(const maps::RoadGraph& graph, const planner::Route& route,
                                            const std::unordered_map<NodeId, maps::SignalPlan>& plans, double now_s);
 
 enum class EntryState { planned, active, released, cancelled, expired };
@@ -66,6 +83,8 @@ struct ScheduleEntry {
   double release_s = 0;
   EntryState state = EntryState::planned;
   bool deferred = false;  // lost arbitration: served right after the winner
+  // Why a vicinity rule moved the start earlier: "approach_queue" or "spillback"; empty otherwise.
+  std::string vicinity;
 };
 
 struct PreemptionEvent {
@@ -96,6 +115,10 @@ class PreemptionEngine {
   // where no queue estimate exists. Throws CountError for values outside their range.
   void record_measurement(NodeId node, maps::Compass approach, std::optional<double> occupancy,
                           std::optional<double> speed_ratio);
+  // The standing queue on an approach, in metres back from the stop line (the longest lane's, as a
+  // lane-area detector's jam length reports it): the vicinity rules' input. Throws CountError for
+  // a negative or non-finite length or a node without a signal.
+  void record_queue_length(NodeId node, maps::Compass approach, double queue_m);
   // Starts holds whose time has come, expires overdue ones, and releases signals no one holds.
   void tick(double now_s);
 
@@ -113,7 +136,15 @@ class PreemptionEngine {
   };
 
   // False when the crossing has no movement in the plan (a U-turn into the approach it came from).
-  bool time_entry(ScheduleEntry& e, const Crossing& c, double now_s);
+  // `previous` is the signalized crossing before `c` on the route, if any.
+  bool time_entry(ScheduleEntry& e, const Crossing& c, const Crossing* previous, double now_s);
+  // The vicinity rules' start for a crossing, and which rule set it; nullopt when neither applies.
+  struct VicinityStart {
+    double start_s;
+    bool spillback;
+  };
+  [[nodiscard]] std::optional<VicinityStart> vicinity_start(const Crossing& c, const Crossing* previous, double trans_s,
+                                                            double now_s) const;
   void arbitrate(NodeId node, double now_s);
   void finish(ScheduleEntry& e, EntryState state, double now_s, const std::string& detail);
   void refresh_node(NodeId node, double now_s);

@@ -296,7 +296,7 @@ void DispatchService::persist_route(Mission& m, const std::string& reason, doubl
 }
 
 void DispatchService::retime_signals(Mission& m, double now_s, Staged& staged) {
-  const auto crossings = preemption::signalized_crossings(m.route, plans_, now_s);
+  const auto crossings = preemption::signalized_crossings(graph_, m.route, plans_, now_s);
   std::lock_guard lock(preemption_mutex_);
   preemption_.update_route(m.row.id, m.row.priority, crossings, now_s);
   drain_preemption_events(staged);

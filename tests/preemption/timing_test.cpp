@@ -82,11 +82,11 @@ TEST(QueueEstimator, RejectsBadCounts) {
 TEST(CongestionClassifier, UsesQueueThenOccupancyThenSpeed) {
   const CongestionClassifierConfig c;  // queue >= 6, occupancy >= 0.3, speed ratio <= 0.5
   EXPECT_EQ(classify_congestion({}, c), CongestionLevel::low);
-  EXPECT_EQ(classify_congestion({6.0, std::nullopt, std::nullopt}, c), CongestionLevel::high);
-  EXPECT_EQ(classify_congestion({2.0, 0.9, 0.1}, c), CongestionLevel::low);  // the queue decides first
-  EXPECT_EQ(classify_congestion({std::nullopt, 0.35, std::nullopt}, c), CongestionLevel::high);
-  EXPECT_EQ(classify_congestion({std::nullopt, std::nullopt, 0.4}, c), CongestionLevel::high);
-  EXPECT_EQ(classify_congestion({std::nullopt, std::nullopt, 0.8}, c), CongestionLevel::low);
+  EXPECT_EQ(classify_congestion({6.0, std::nullopt, std::nullopt, std::nullopt}, c), CongestionLevel::high);
+  EXPECT_EQ(classify_congestion({2.0, 0.9, 0.1, std::nullopt}, c), CongestionLevel::low);  // the queue decides first
+  EXPECT_EQ(classify_congestion({std::nullopt, 0.35, std::nullopt, std::nullopt}, c), CongestionLevel::high);
+  EXPECT_EQ(classify_congestion({std::nullopt, std::nullopt, 0.4, std::nullopt}, c), CongestionLevel::high);
+  EXPECT_EQ(classify_congestion({std::nullopt, std::nullopt, 0.8, std::nullopt}, c), CongestionLevel::low);
 }
 
 }  // namespace
