@@ -45,6 +45,9 @@ struct SimOptions {
   double gps_rate_hz = 1.0;
   std::vector<std::string> gps_outages;
   std::string token;
+  std::uint32_t evs = 1;
+  bool route_only = false;
+  bool time_space = false;
 };
 
 sim::EvRouting parse_routing(const std::string& s) {
@@ -90,6 +93,15 @@ void run_sim(const SimOptions& o) {
   if (!o.ev_to.empty()) c.ev_to = o.ev_to;
   c.ev_depart_s = begin_s + o.ev_depart_s;
   c.end_s = begin_s + end_after_begin;
+  if (o.evs == 0 || o.evs > 16) throw UsageError("--evs must be in [1, 16]");
+  if (o.evs > 1 && !o.server.empty()) throw UsageError("--evs above 1 runs in the in-process loop, not through --server");
+  if (o.evs > 1 && o.no_ev) throw UsageError("--evs and --no-ev exclude each other");
+  if (o.evs > 1) {
+    c.more_evs = sim::conflicting_ev_trips(*scenario, {c.ev_from, c.ev_to, c.ev_depart_s, 1}, o.evs - 1, o.seed, c.ev_vmax_kmh);
+    c.first_priority = static_cast<int>(o.evs);
+  }
+  c.vicinity = !o.route_only;
+  c.record_time_space = o.time_space;
   c.demand_scale = o.demand_scale;
   c.seed = o.seed;
   c.congestion_period_s = o.congestion_period_s;
@@ -151,6 +163,8 @@ void run_sim(const SimOptions& o) {
   record.ev_from = c.ev_from;
   record.ev_to = c.ev_to;
   record.ev_depart_s = c.ev_depart_s;
+  record.vicinity = c.vicinity;
+  record.evs = o.evs;
   record.result = sim::run_closed_loop(*scenario, c);
   const std::string text = sim::to_json_record(record).dump(2);
   if (!o.result_file.empty()) {
@@ -200,6 +214,13 @@ void register_sim_command(CLI::App& app) {
   cmd->add_option("--gps-rate-hz", o->gps_rate_hz, "with --gps-noise-m: fixes per second")->capture_default_str();
   cmd->add_option("--gps-outage", o->gps_outages,
                   "with --gps-noise-m: START:DURATION s after the EV departs with HDOP > 10 fixes; onboard odometry posts source vo");
+  cmd->add_option("--evs", o->evs,
+                  "EVs in the run: the further ones cross the first's lights from other approaches at the same time, "
+                  "with falling priority")
+      ->capture_default_str();
+  cmd->add_flag("--route-only", o->route_only, "the seed's route-only preemption, without the vicinity rules");
+  cmd->add_flag("--time-space", o->time_space,
+                "write the EVs' trajectories and lights (RUN.ev_trajectory.csv, RUN.ev_signals.csv, RUN.time_space.svg)");
   cmd->callback([o] { run_sim(*o); });
 }
 
@@ -251,7 +272,10 @@ void register_sumo_experiment(CLI::App& experiment) {
       ->expected(1, -1);
   auto libsumo = std::make_shared<bool>(false);
   cmd->add_flag("--libsumo", *libsumo, "run SUMO inside each run's process (libsumo) instead of over TraCI");
-  cmd->callback([o, signals, routings, emit_jobs, collect, end_s, libsumo] {
+  cmd->add_option("--evs", o->evs, "EVs per run (the further ones conflict with the first at its lights)")->capture_default_str();
+  auto route_only = std::make_shared<bool>(false);
+  cmd->add_flag("--route-only", *route_only, "the seed's route-only preemption, without the vicinity rules");
+  cmd->callback([o, signals, routings, emit_jobs, collect, end_s, libsumo, route_only] {
     if (!emit_jobs->empty() && !collect->empty()) throw UsageError("--emit-jobs and --collect are two steps: give one");
     if (!collect->empty()) {
       std::vector<std::filesystem::path> dirs(collect->begin(), collect->end());
@@ -261,6 +285,8 @@ void register_sumo_experiment(CLI::App& experiment) {
       return;
     }
     o->backend = *libsumo ? sim::SumoBackend::libsumo : sim::SumoBackend::traci;
+    o->vicinity = !*route_only;
+    if (o->evs == 0 || o->evs > 16) throw UsageError("--evs must be in [1, 16]");
     o->end_s = *end_s;
     o->signals.clear();
     for (const std::string& s : *signals) o->signals.push_back(parse_signals(s));

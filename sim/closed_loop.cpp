@@ -14,6 +14,7 @@
 #include "planner/experiments/scenario_generator.hpp"
 #include "planner/one_to_one_search.hpp"
 #include "preemption/engine.hpp"
+#include "preemption/signal_costs.hpp"
 #include "sim/errors.hpp"
 #include "sim/closed_loop_run.hpp"
 
@@ -82,10 +83,17 @@ std::vector<Approach> approaches_of(const SumoScenario& scenario) {
     if (g.in_edges(node).empty()) continue;
     const maps::SumoEdge* se = scenario.net.edge(sg.sumo_edge_of_node[node.index()]);
     if (se == nullptr) continue;
-    Approach a{node, maps::approach_side(g, g.in_edges(node).front()), {}, 0.0, {}, 0.0, 0.0, 0.0};
+    Approach a;
+    a.node = node;
+    a.side = maps::approach_side(g, g.in_edges(node).front());
     for (const auto& lane : se->lanes) {
       a.lanes.push_back(lane.id);
       a.length_m += lane.length_m;
+      if (!scenario.config) continue;
+      for (const auto& d : scenario.config->lane_area_detectors) {
+        const bool covers = std::find(d.lanes.begin(), d.lanes.end(), lane.id) != d.lanes.end();
+        if (covers && std::find(a.detectors.begin(), a.detectors.end(), d.id) == a.detectors.end()) a.detectors.push_back(d.id);
+      }
     }
     approaches.push_back(std::move(a));
   }
@@ -130,18 +138,31 @@ SumoLaunch launch_for(const SumoScenario& scenario, const ClosedLoopConfig& conf
   return launch;
 }
 
-void add_trip_results(const std::filesystem::path& tripinfo, ClosedLoopResult& result) {
+void add_trip_results(const std::filesystem::path& tripinfo, const std::vector<std::string>& ev_ids, ClosedLoopResult& result) {
   double loss = 0.0;
+  result.evs.assign(ev_ids.size(), EvOutcome{});
+  for (std::size_t k = 0; k < ev_ids.size(); ++k) result.evs[k].id = ev_ids[k];
   for (const TripInfo& trip : read_tripinfo(tripinfo)) {
-    if (trip.id == kEv) {
-      if (trip.arrival_s >= 0.0) result.ev_travel_time_s = trip.duration_s;
-      result.ev_stops = trip.waiting_count;
-      result.ev_wait_s = trip.waiting_time_s;
-      result.ev_time_loss_s = trip.time_loss_s;
+    const auto ev = std::find(ev_ids.begin(), ev_ids.end(), trip.id);
+    if (ev != ev_ids.end()) {
+      EvOutcome& o = result.evs[static_cast<std::size_t>(ev - ev_ids.begin())];
+      o.arrived = trip.arrival_s >= 0.0;
+      if (o.arrived) o.travel_time_s = trip.duration_s;
+      o.stops = trip.waiting_count;
+      o.wait_s = trip.waiting_time_s;
+      o.time_loss_s = trip.time_loss_s;
       continue;
     }
     loss += trip.time_loss_s;
     ++result.others;
+  }
+  if (!result.evs.empty()) {
+    const EvOutcome& first = result.evs.front();
+    result.ev_arrived = result.ev_arrived || first.arrived;
+    if (first.arrived) result.ev_travel_time_s = first.travel_time_s;
+    result.ev_stops = first.stops;
+    result.ev_wait_s = first.wait_s;
+    result.ev_time_loss_s = first.time_loss_s;
   }
   result.others_mean_time_loss_s = result.others > 0 ? loss / static_cast<double>(result.others) : 0.0;
 }
@@ -150,10 +171,15 @@ void count_lane_vehicles(const libsumo::SubscriptionResults& lanes, std::vector<
   for (Approach& a : approaches) {
     std::set<std::string> now;
     double halting = 0.0;
+    a.queue_m = 0.0;
     for (const auto& lane : a.lanes) {
       const auto it = lanes.find(lane);
       if (it == lanes.end()) continue;
-      halting += as_double(it->second, libsumo::LAST_STEP_VEHICLE_HALTING_NUMBER);
+      const double lane_halting = as_double(it->second, libsumo::LAST_STEP_VEHICLE_HALTING_NUMBER);
+      if (!std::isfinite(lane_halting)) continue;
+      halting += lane_halting;
+      // Halted vehicles queue from the stop line back: 7.5 m each, the occupancy's jam spacing.
+      a.queue_m = std::max(a.queue_m, 7.5 * lane_halting);
       if (const auto ids = it->second.find(libsumo::LAST_STEP_VEHICLE_ID_LIST); ids != it->second.end()) {
         if (const auto list = std::dynamic_pointer_cast<libsumo::TraCIStringList>(ids->second)) {
           now.insert(list->value.begin(), list->value.end());
@@ -164,6 +190,23 @@ void count_lane_vehicles(const libsumo::SubscriptionResults& lanes, std::vector<
     for (const auto& v : a.vehicles) a.departures += now.contains(v) ? 0.0 : 1.0;
     a.vehicles = std::move(now);
     a.halting = halting;
+  }
+}
+
+void add_detector_queues(const libsumo::SubscriptionResults& detectors, std::vector<Approach>& approaches) {
+  for (Approach& a : approaches) {
+    if (a.detectors.empty()) continue;
+    double jam = 0.0;
+    bool any = false;
+    for (const auto& id : a.detectors) {
+      const auto it = detectors.find(id);
+      if (it == detectors.end()) continue;
+      const double m = as_double(it->second, libsumo::JAM_LENGTH_METERS);
+      if (!std::isfinite(m) || m < 0.0) continue;
+      jam = std::max(jam, m);
+      any = true;
+    }
+    if (any) a.queue_m = jam;
   }
 }
 
@@ -224,7 +267,72 @@ std::pair<std::string, std::string> pick_ev_trip(const SumoScenario& scenario, s
   throw SimError("no connected start/goal pair for the emergency vehicle on " + scenario.name);
 }
 
+std::vector<EvTrip> conflicting_ev_trips(const SumoScenario& scenario, const EvTrip& first, std::size_t count,
+                                         std::uint64_t seed, double ev_vmax_kmh) {
+  std::vector<EvTrip> trips;
+  if (count == 0) return trips;
+  const auto& sg = scenario.graph;
+  const auto& g = sg.graph;
+  // The loop's own initial costs, so that the predicted meeting is the one the planners will see.
+  planner::CostOverlay overlay(g);
+  preemption::set_signal_costs(overlay, scenario.plans, preemption::SignalCostRule::preempted);
+  const planner::TravelCost cost(g, overlay, {ev_vmax_kmh / 3.6});
+  planner::OneToOneSearch search;
+  const auto starts = detail::points_on(sg, first.from, 0.0);
+  const auto goals = detail::points_on(sg, first.to, std::nullopt);
+  if (starts.empty() || goals.empty()) throw SimError("the first EV's edges '" + first.from + "', '" + first.to + "' are not drivable");
+  const planner::Route main = search.run(planner::SearchSpace(cost, starts, goals), true);
+  // The first EV's lights, with its approach edge and predicted arrival there.
+  struct Light {
+    std::string tls;
+    std::string approach;
+    double arrival_s;
+  };
+  std::vector<Light> lights;
+  for (std::size_t i = 0; i < main.nodes.size(); ++i) {
+    const auto it = scenario.sumo_plan_of.find(main.nodes[i]);
+    if (it != scenario.sumo_plan_of.end()) lights.push_back({it->second->tls_id, sg.sumo_edge_of_node[main.nodes[i].index()], first.depart_s + main.arrival_s[i]});
+  }
+  if (lights.empty()) throw SimError("the first EV's route crosses no traffic light, so no other EV can conflict with it");
+  planner::Rng rng(planner::derive_seed(seed, "conflicting-evs/" + scenario.name));
+  const auto m = static_cast<std::uint32_t>(g.edge_count());
+  for (std::size_t k = 0; k < count; ++k) {
+    // The k-th shares the first's (k mod n)-th light from the middle of its route outwards.
+    const Light& light = lights[(lights.size() / 2 + k) % lights.size()];
+    bool found = false;
+    for (int attempt = 0; attempt < 50000 && !found; ++attempt) {
+      const EdgeId a{rng.below(m)};
+      const EdgeId b{rng.below(m)};
+      if (a == b) continue;
+      // Between SUMO edges, as the loop will plan it: from any way onto the start to any onto the goal.
+      const planner::Route r = search.run(planner::SearchSpace(cost, detail::points_on(sg, sg.sumo_edge_of_arc[a.index()], 0.0),
+                                                               detail::points_on(sg, sg.sumo_edge_of_arc[b.index()], std::nullopt)),
+                                          true);
+      if (!r.found || r.edges.size() < 4) continue;
+      for (std::size_t i = 0; i < r.nodes.size() && i + 1 < r.edges.size(); ++i) {
+        const auto it = scenario.sumo_plan_of.find(r.nodes[i]);
+        if (it == scenario.sumo_plan_of.end() || it->second->tls_id != light.tls) continue;
+        // Another approach into the same light, at least 20 s of driving before it.
+        if (sg.sumo_edge_of_node[r.nodes[i].index()] == light.approach || r.arrival_s[i] < 20.0) break;
+        const double depart = light.arrival_s - r.arrival_s[i];
+        if (depart < 0.0) break;
+        spdlog::debug("event=conflicting_ev tls={} first_arrival_s={:.1f} its_arrival_after_s={:.1f} depart_s={:.1f}", light.tls,
+                     light.arrival_s, r.arrival_s[i], depart);
+        trips.push_back({sg.sumo_edge_of_arc[a.index()], sg.sumo_edge_of_arc[b.index()], depart,
+                         static_cast<int>(count - k)});
+        found = true;
+        break;
+      }
+    }
+    if (!found) throw SimError("no trip crosses traffic light '" + light.tls + "' from another approach on " + scenario.name);
+  }
+  return trips;
+}
+
 ClosedLoopResult run_closed_loop(const SumoScenario& scenario, const ClosedLoopConfig& config) {
+  if (!config.server_url.empty() && !config.more_evs.empty()) {
+    throw SimError("several EVs (--evs) run in the in-process loop only, not through a server (--server)");
+  }
   if (!config.server_url.empty()) return run_closed_loop_server(scenario, config);
   return config.backend == SumoBackend::libsumo ? run_closed_loop_libsumo(scenario, config)
                                                 : run_closed_loop_traci(scenario, config);

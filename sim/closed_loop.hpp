@@ -31,6 +31,15 @@ std::optional<EvSignals> parse_ev_signals(const std::string& text);
 [[nodiscard]] inline bool preempts(EvSignals s) { return s == EvSignals::corridor || s == EvSignals::corridor_bluelight; }
 [[nodiscard]] inline bool has_bluelight(EvSignals s) { return s == EvSignals::bluelight || s == EvSignals::corridor_bluelight; }
 
+// One emergency vehicle's trip: SUMO edges, departure (simulation time) and mission priority
+// (higher is served first where two vehicles claim one signal).
+struct EvTrip {
+  std::string from;
+  std::string to;
+  double depart_s = 0.0;
+  int priority = 1;
+};
+
 struct ClosedLoopConfig {
   bool with_ev = true;  // false: the baseline run for other vehicles' delay
   SumoBackend backend = SumoBackend::traci;
@@ -60,6 +69,29 @@ struct ClosedLoopConfig {
   double gps_noise_m = 0.0;
   double gps_rate_hz = 1.0;
   std::vector<std::pair<double, double>> gps_outages;
+  // Further EVs in the same run (`--evs N`), each its own mission with its own route; the first EV
+  // is ev_from/ev_to/ev_depart_s with priority first_priority.
+  std::vector<EvTrip> more_evs;
+  int first_priority = 1;
+  // Vicinity-aware preemption: measured standing queues on the route's approaches start holds early
+  // enough that the EV meets no queue, and flush a link about to spill back into the junction
+  // before (preemption::VicinityConfig). Off: the seed's route-only preemption.
+  bool vicinity = true;
+  // Writes <run>.ev_trajectory.csv, <run>.ev_signals.csv and <run>.time_space.svg.
+  bool record_time_space = false;
+};
+
+// One EV's outcome in a run.
+struct EvOutcome {
+  std::string id;  // SUMO vehicle id: "ev", then "ev2", "ev3", ...
+  EvTrip trip;
+  bool arrived = false;
+  double travel_time_s = 0.0;
+  int stops = 0;
+  double wait_s = 0.0;
+  double time_loss_s = 0.0;
+  std::size_t deferrals = 0;  // its claims that lost arbitration to a higher one
+  std::size_t preempted_signals = 0;
 };
 
 struct ClosedLoopResult {
@@ -82,10 +114,20 @@ struct ClosedLoopResult {
   double others_mean_time_loss_s = 0.0;
   std::size_t others = 0;
   double end_time_s = 0.0;
+  std::vector<EvOutcome> evs;  // every EV, the first one first (its figures are also the fields above)
+  std::size_t deferrals = 0;   // over all EVs
+  std::size_t approaches_with_detectors = 0;  // approaches whose queue comes from the user's e2 detectors
 };
 
 // Throws SimError when SUMO fails or the EV's edges are unknown or unconnected.
 ClosedLoopResult run_closed_loop(const SumoScenario& scenario, const ClosedLoopConfig& config);
+
+// `count` further EVs for a run whose first EV drives `first`: each crosses a signal of the first's
+// route from another approach, departing so that both are predicted there at the same time, which
+// makes their claims conflict. Priorities fall with the index (the first EV keeps the highest).
+// Throws SimError when the network has no such trip.
+std::vector<EvTrip> conflicting_ev_trips(const SumoScenario& scenario, const EvTrip& first, std::size_t count,
+                                         std::uint64_t seed, double ev_vmax_kmh);
 
 // A start and goal for the EV: far apart, connected, on edges SUMO lets it drive, and with at
 // least two traffic lights between them where the network has two.

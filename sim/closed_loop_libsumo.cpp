@@ -11,6 +11,7 @@ struct LibsumoApi {
   using Simulation = libsumo::Simulation;
   using Edge = libsumo::Edge;
   using Lane = libsumo::Lane;
+  using LaneArea = libsumo::LaneArea;
   using Route = libsumo::Route;
   using Vehicle = libsumo::Vehicle;
   using TrafficLight = libsumo::TrafficLight;

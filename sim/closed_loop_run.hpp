@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
+#include <map>
 #include <optional>
 #include <set>
 #include <span>
@@ -25,6 +26,7 @@
 #include "sim/errors.hpp"
 #include "sim/sumo_bridge.hpp"
 #include "sim/sumo_signal_controller.hpp"
+#include "sim/time_space.hpp"
 #include "sim/tripinfo.hpp"
 
 namespace corridor::sim {
@@ -65,16 +67,21 @@ struct Approach {
   double halting = 0.0;            // halted at the last step
   double arrivals = 0.0;           // since the last report
   double departures = 0.0;
+  double queue_m = 0.0;                // the longest lane's standing queue, metres from the stop line
+  std::vector<std::string> detectors;  // the user's e2 detectors on its lanes
   // 7.5 m of lane per halted vehicle.
   [[nodiscard]] double occupancy() const { return length_m > 0.0 ? std::clamp(halting * 7.5 / length_m, 0.0, 1.0) : 0.0; }
 };
 std::vector<Approach> approaches_of(const SumoScenario& scenario);
 // The run's SUMO files: net, background routes, the EV types, tripinfo and log, fresh for the run.
 SumoLaunch launch_for(const SumoScenario& scenario, const ClosedLoopConfig& config);
-// The EV's travel time, stops and waits, and the other vehicles' mean time loss, from tripinfo.
-void add_trip_results(const std::filesystem::path& tripinfo, ClosedLoopResult& result);
+// Each EV's travel time, stops and waits (result.evs, in the order of `ev_ids`, and the first EV's
+// in the ev_* fields), and the other vehicles' mean time loss, from tripinfo.
+void add_trip_results(const std::filesystem::path& tripinfo, const std::vector<std::string>& ev_ids, ClosedLoopResult& result);
 // Updates every approach from its lanes' subscription results (vehicle ids and halting counts).
 void count_lane_vehicles(const libsumo::SubscriptionResults& lanes, std::vector<Approach>& approaches);
+// The user's lane-area detectors' jam lengths, where an approach has them, replace its lanes' own.
+void add_detector_queues(const libsumo::SubscriptionResults& detectors, std::vector<Approach>& approaches);
 
 struct Incident {
   double time_s;
@@ -104,6 +111,46 @@ class ApiTrafficLights final : public TrafficLightApi {
   double now_s = 0.0;  // the simulation time, needed for spent_s; set by the loop every step
 };
 
+// One EV of a run: its mission, its planner, and where SUMO has it.
+struct EvRun {
+  std::string id;
+  EvTrip trip;
+  preemption::MissionId mission = 0;
+  std::vector<planner::EdgePoint> starts;
+  std::vector<planner::EdgePoint> goals;
+  std::optional<planner::DStarLite> dstar;
+  std::vector<EdgeId> route;    // as last sent to SUMO, from the EV's edge on
+  std::size_t route_index = 0;  // where the EV is on `route`
+  bool added = false, seen = false, done = false;
+  double depart = 0.0;
+  std::string edge;  // the SUMO edge the EV is on
+  double pos = 0.0;
+  std::set<NodeId> preempted;
+  std::size_t deferrals = 0;
+  // Time–space record: distance driven on the edges behind, and the lights of the crossings ahead.
+  double driven_m = 0.0;
+  std::vector<preemption::Crossing> ahead;
+  std::map<NodeId, TimeSpaceSignal> seen_signals;  // sampled while ahead
+  TimeSpaceTrack track;
+};
+
+// The light the EV's movement shows at a crossing: 'G' when any of its links is green, else 'y'
+// when one is yellow, else 'r'.
+inline char movement_light(const SumoScenario& scenario, const preemption::Crossing& c, const std::string& state) {
+  const auto it = scenario.sumo_plan_of.find(c.node);
+  if (it == scenario.sumo_plan_of.end()) return 'r';
+  const std::string& from = scenario.graph.sumo_edge_of_arc[c.in_edge.index()];
+  const std::string& to = scenario.graph.sumo_edge_of_arc[c.out_edge.index()];
+  char best = 'r';
+  for (std::size_t i = 0; i < it->second->links.size() && i < state.size(); ++i) {
+    const maps::SumoConnection* link = it->second->links[i];
+    if (link == nullptr || link->from != from || link->to != to) continue;
+    if (state[i] == 'G' || state[i] == 'g') return 'G';
+    if (state[i] == 'y' || state[i] == 'Y') best = 'y';
+  }
+  return best;
+}
+
 template <class Api, class Session>
 ClosedLoopResult run_loop(const SumoScenario& scenario, const ClosedLoopConfig& config) {
   const auto& sg = scenario.graph;
@@ -118,56 +165,73 @@ ClosedLoopResult run_loop(const SumoScenario& scenario, const ClosedLoopConfig& 
   preemption::set_signal_costs(overlay, scenario.plans,
                                preempts(config.signals) ? preemption::SignalCostRule::preempted : preemption::SignalCostRule::normal);
   const planner::TravelCost cost(g, overlay, {vmax_mps});
-  const std::vector<planner::EdgePoint> starts = points_on(sg, config.ev_from, 0.0);
-  const std::vector<planner::EdgePoint> goals = points_on(sg, config.ev_to, std::nullopt);
-  if (config.with_ev && (starts.empty() || goals.empty())) {
-    throw SimError("the EV's start edge '" + config.ev_from + "' or goal edge '" + config.ev_to +
-                   "' is not a drivable edge of the network");
+
+  std::vector<EvRun> evs;
+  if (config.with_ev) {
+    std::vector<EvTrip> trips{{config.ev_from, config.ev_to, config.ev_depart_s, config.first_priority}};
+    trips.insert(trips.end(), config.more_evs.begin(), config.more_evs.end());
+    for (std::size_t k = 0; k < trips.size(); ++k) {
+      EvRun ev;
+      ev.id = k == 0 ? std::string(kEv) : fmt::format("{}{}", kEv, k + 1);
+      ev.trip = trips[k];
+      ev.mission = kMission + k;
+      ev.starts = points_on(sg, ev.trip.from, 0.0);
+      ev.goals = points_on(sg, ev.trip.to, std::nullopt);
+      ev.edge = ev.trip.from;
+      ev.track.ev = ev.id;
+      if (ev.starts.empty() || ev.goals.empty()) {
+        throw SimError("the EV's start edge '" + ev.trip.from + "' or goal edge '" + ev.trip.to +
+                       "' is not a drivable edge of the network");
+      }
+      evs.push_back(std::move(ev));
+    }
   }
 
   const SumoLaunch launch = launch_for(scenario, config);
   Session bridge(launch);
 
   ApiTrafficLights<Api> lights_api;
-  SumoSignalController controller(scenario.plans, scenario.sumo_plan_of, scenario.tls_phases, lights_api);
-  preemption::PreemptionEngine engine(g, scenario.plans, controller);
+  // One controller and one engine entry per light, whichever approach a claim comes from.
+  SumoSignalController controller(scenario.signal_plans, scenario.sumo_plan_of, scenario.tls_phases, lights_api);
+  preemption::PreemptionConfig preemption_config;
+  preemption_config.vicinity.enabled = config.vicinity;
+  preemption::PreemptionEngine engine(g, scenario.signal_plans, controller, preemption_config);
 
   Api::Simulation::subscribe(std::vector<int>{libsumo::VAR_COLLIDING_VEHICLES_NUMBER, libsumo::VAR_TELEPORT_STARTING_VEHICLES_NUMBER});
   for (const auto& [id, arcs] : sg.arcs_onto) Api::Edge::subscribe(id, {libsumo::VAR_CURRENT_TRAVELTIME});
-  // Halting vehicles on each approach lane of a preemptable light: the congestion classifier's input.
+  // Halting vehicles on each approach lane of a preemptable light: the congestion classifier's and
+  // the vicinity rules' input; the user's lane-area detectors, where they cover a lane, instead.
   std::vector<Approach> approaches = approaches_of(scenario);
+  ClosedLoopResult result;
   for (const Approach& a : approaches) {
     for (const auto& lane : a.lanes) {
       Api::Lane::subscribe(lane, {libsumo::LAST_STEP_VEHICLE_HALTING_NUMBER, libsumo::LAST_STEP_VEHICLE_ID_LIST});
     }
+    for (const auto& detector : a.detectors) Api::LaneArea::subscribe(detector, {libsumo::JAM_LENGTH_METERS});
+    if (!a.detectors.empty()) ++result.approaches_with_detectors;
   }
 
-  ClosedLoopResult result;
-  std::optional<planner::DStarLite> dstar;
-  std::vector<EdgeId> route;       // as last sent to SUMO, from the EV's edge on
-  std::size_t route_index = 0;     // where the EV is on `route`
-  bool ev_added = false, ev_seen = false, ev_done = false;
-  double ev_depart = 0.0;
-  std::string ev_edge = config.ev_from;  // the SUMO edge the EV is on
-  double ev_pos = 0.0;
   double last_congestion_s = -1e9;
-  // Unforeseen incidents on the EV's free-flow route, after it has left: the same in every run of a
-  // seed, the baseline without the EV included, so that they do not count as the EV's doing.
+  // Unforeseen incidents on the first EV's free-flow route, after it has left: the same in every
+  // run of a seed, the baseline without the EV included, so that they do not count as its doing.
   std::vector<Incident> incidents;
-  if (!starts.empty() && !goals.empty() && config.incidents > 0) {
+  if (config.incidents > 0) {
+    const auto starts = points_on(sg, config.ev_from, 0.0);
+    const auto goals = points_on(sg, config.ev_to, std::nullopt);
     planner::Rng rng(planner::derive_seed(config.seed, "incidents"));
     const planner::CostOverlay free_flow(g);
     const planner::TravelCost free_cost(g, free_flow, {vmax_mps});
     planner::OneToOneSearch search;
-    const planner::Route r = search.run(planner::SearchSpace(free_cost, starts, goals), true);
+    const planner::Route r = starts.empty() || goals.empty() ? planner::Route{}
+                                                             : search.run(planner::SearchSpace(free_cost, starts, goals), true);
     for (std::uint32_t k = 0; k < config.incidents && r.found && r.edges.size() > 3; ++k) {
       const EdgeId e = r.edges[1 + rng.below(static_cast<std::uint32_t>(r.edges.size() - 2))];
       incidents.push_back({config.ev_depart_s + rng.uniform(10.0, 60.0), sg.sumo_edge_of_arc[e.index()]});
     }
   }
-  std::set<NodeId> preempted;
 
   double t = 0.0;
+  double last_sample_s = -1e9;
   for (int step = 0; t < config.end_s; ++step) {
     t = bridge.step();
     lights_api.now_s = t;
@@ -197,28 +261,41 @@ ClosedLoopResult run_loop(const SumoScenario& scenario, const ClosedLoopConfig& 
         }
       }
       result.congestion_updates += static_cast<std::uint32_t>(changed.size());
+      add_detector_queues(Api::LaneArea::getAllSubscriptionResults(), approaches);
+      // Detector counts for the queue estimate, and halting vehicles as occupancy where the
+      // estimate has no data yet; the standing queue's length for the vicinity rules. Per light and
+      // side: two stop lines of one light that face the same way are one approach to the engine.
+      struct Measured {
+        double arrivals = 0.0, departures = 0.0, occupancy = 0.0, queue_m = 0.0;
+      };
+      std::map<std::pair<NodeId, maps::Compass>, Measured> measured;
       for (Approach& a : approaches) {
-        // Detector counts for the queue estimate, and halting vehicles as occupancy where the
-        // estimate has no data yet.
-        engine.record_counts(a.node, a.side, t, a.arrivals, a.departures);
+        Measured& m = measured[{signal_of(scenario, a.node), a.side}];
+        m.arrivals += a.arrivals;
+        m.departures += a.departures;
+        m.occupancy = std::max(m.occupancy, a.occupancy());
+        m.queue_m = std::max(m.queue_m, a.queue_m);
         a.arrivals = a.departures = 0.0;
-        engine.record_measurement(a.node, a.side, a.occupancy(), std::nullopt);
+      }
+      for (const auto& [key, m] : measured) {
+        engine.record_counts(key.first, key.second, t, m.arrivals, m.departures);
+        engine.record_measurement(key.first, key.second, m.occupancy, std::nullopt);
+        engine.record_queue_length(key.first, key.second, m.queue_m);
       }
     }
 
-    if (config.with_ev && !ev_added && t >= config.ev_depart_s) {
-      dstar.emplace(cost, starts, goals);
-      dstar->replan();
-      const planner::Route r = dstar->route();
-      if (!r.found) throw SimError("the EV's goal cannot be reached from its start");
-      route = r.edges;
-      Api::Route::add("ev_route", sumo_ids(sg, route));
-      Api::Vehicle::add(kEv, "ev_route", ev_type(config.signals), "now",
-                             "best", "base", "max");
-      Api::Vehicle::subscribe(kEv, {libsumo::VAR_ROAD_ID, libsumo::VAR_LANEPOSITION, libsumo::VAR_SPEED});
-      ev_added = true;
-      ev_depart = t;
-      changed.clear();  // the new planner already knows every update so far
+    for (EvRun& ev : evs) {
+      if (ev.added || t < ev.trip.depart_s) continue;
+      ev.dstar.emplace(cost, ev.starts, ev.goals);
+      ev.dstar->replan();
+      const planner::Route r = ev.dstar->route();
+      if (!r.found) throw SimError("the goal of EV '" + ev.id + "' cannot be reached from its start");
+      ev.route = r.edges;
+      Api::Route::add(ev.id + "_route", sumo_ids(sg, ev.route));
+      Api::Vehicle::add(ev.id, ev.id + "_route", ev_type(config.signals), "now", "best", "base", "max");
+      Api::Vehicle::subscribe(ev.id, {libsumo::VAR_ROAD_ID, libsumo::VAR_LANEPOSITION, libsumo::VAR_SPEED});
+      ev.added = true;
+      ev.depart = t;
     }
     for (Incident& inc : incidents) {
       if (!inc.applied && t >= inc.time_s) {
@@ -228,87 +305,131 @@ ClosedLoopResult run_loop(const SumoScenario& scenario, const ClosedLoopConfig& 
       }
     }
 
-    if (ev_added && !ev_done) {
-      const auto ev = Api::Vehicle::getSubscriptionResults(kEv);
-      if (ev.empty()) {
-        if (ev_seen) {
-          ev_done = true;
-          result.ev_arrived = true;
-          result.ev_travel_time_s = t - ev_depart;
-          if (preempts(config.signals)) engine.cancel(kMission, t);
+    const bool sample = config.record_time_space && t - last_sample_s >= 1.0 - 1e-9;
+    if (sample) last_sample_s = t;
+    for (EvRun& ev : evs) {
+      if (!ev.added || ev.done) continue;
+      const bool fresh = ev.depart == t;  // its planner already knows every update so far
+      const auto state = Api::Vehicle::getSubscriptionResults(ev.id);
+      if (state.empty()) {
+        if (ev.seen) {
+          ev.done = true;
+          if (preempts(config.signals)) engine.cancel(ev.mission, t);
+        }
+        continue;
+      }
+      ev.seen = true;
+      const std::string road = as_string(state, libsumo::VAR_ROAD_ID);
+      if (!road.empty() && road[0] != ':' && !sg.arcs(road).empty()) {
+        if (road != ev.edge) {
+          // Onto a new edge: the EV has crossed the stop line of the one it left.
+          const NodeId line = signal_of(scenario, sg.stop_line.at(ev.edge));
+          if (preempts(config.signals)) engine.vehicle_passed(ev.mission, line, t);
+          ev.driven_m += g.length_m(sg.arcs(ev.edge).front());
+          if (auto it = ev.seen_signals.find(line); it != ev.seen_signals.end()) {
+            it->second.distance_m = ev.driven_m;
+            it->second.preempted = ev.preempted.contains(line);
+            it->second.states.emplace_back(t, it->second.states.empty() ? 'r' : it->second.states.back().second);
+            ev.track.signals.push_back(std::move(it->second));
+            ev.seen_signals.erase(it);
+          }
+        }
+        ev.edge = road;
+        ev.pos = std::clamp(as_double(state, libsumo::VAR_LANEPOSITION), 0.0, g.length_m(sg.arcs(road).front()));
+        std::size_t k = ev.route_index;
+        while (k < ev.route.size() && sg.sumo_edge_of_arc[ev.route[k].index()] != ev.edge) ++k;
+        if (k < ev.route.size()) ev.route_index = k;
+      }
+      if (sample) {
+        ev.track.t_s.push_back(t);
+        ev.track.distance_m.push_back(ev.driven_m + ev.pos);
+        const double speed = as_double(state, libsumo::VAR_SPEED);  // SUMO's invalid value before the first step
+        ev.track.speed_mps.push_back(std::isfinite(speed) && speed >= 0.0 ? speed : 0.0);
+      }
+      planner::Route plan;
+      if (config.routing == EvRouting::dynamic_route) {
+        ev.dstar->move_start(points_on(sg, ev.edge, ev.pos));
+        if (!changed.empty() && !fresh) ev.dstar->edges_changed(changed);
+        ev.dstar->replan();
+        plan = ev.dstar->route();
+        if (!changed.empty() && ev.id == kEv) ++result.replans;
+        // The route SUMO has from here on; setRoute must start with the EV's current edge.
+        const std::vector<EdgeId> rest(ev.route.begin() + static_cast<std::ptrdiff_t>(ev.route_index), ev.route.end());
+        if (plan.found && sumo_ids(sg, plan.edges) != sumo_ids(sg, rest) &&
+            sg.sumo_edge_of_arc[plan.edges.front().index()] == ev.edge) {
+          try {
+            Api::Vehicle::setRoute(ev.id, sumo_ids(sg, plan.edges));
+            ev.route = plan.edges;
+            ev.route_index = 0;
+            if (ev.id == kEv) ++result.route_changes;
+          } catch (const libsumo::TraCIException& e) {
+            spdlog::debug("event=set_route_refused t={:.0f} ev={} reason=\"{}\"", t, ev.id, e.what());
+          }
         }
       } else {
-        ev_seen = true;
-        const std::string road = as_string(ev, libsumo::VAR_ROAD_ID);
-        if (!road.empty() && road[0] != ':' && !sg.arcs(road).empty()) {
-          if (road != ev_edge && preempts(config.signals)) {
-            // Onto a new edge: the EV has crossed the stop line of the one it left.
-            engine.vehicle_passed(kMission, sg.stop_line.at(ev_edge), t);
-          }
-          ev_edge = road;
-          ev_pos = std::clamp(as_double(ev, libsumo::VAR_LANEPOSITION), 0.0, g.length_m(sg.arcs(road).front()));
-          std::size_t k = route_index;
-          while (k < route.size() && sg.sumo_edge_of_arc[route[k].index()] != ev_edge) ++k;
-          if (k < route.size()) route_index = k;
-        }
-        planner::Route plan;
-        if (config.routing == EvRouting::dynamic_route) {
-          dstar->move_start(points_on(sg, ev_edge, ev_pos));
-          if (!changed.empty()) dstar->edges_changed(changed);
-          dstar->replan();
-          plan = dstar->route();
-          if (!changed.empty()) ++result.replans;
-          // The route SUMO has from here on; setRoute must start with the EV's current edge.
-          const std::vector<EdgeId> ahead(route.begin() + static_cast<std::ptrdiff_t>(route_index), route.end());
-          if (plan.found && sumo_ids(sg, plan.edges) != sumo_ids(sg, ahead) &&
-              sg.sumo_edge_of_arc[plan.edges.front().index()] == ev_edge) {
-            try {
-              Api::Vehicle::setRoute(kEv, sumo_ids(sg, plan.edges));
-              route = plan.edges;
-              route_index = 0;
-              ++result.route_changes;
-            } catch (const libsumo::TraCIException& e) {
-              spdlog::debug("event=set_route_refused t={:.0f} reason=\"{}\"", t, e.what());
-            }
-          }
-        } else {
-          plan = planner::make_route(cost, {route[route_index], ev_pos},
-                                     std::vector<EdgeId>(route.begin() + static_cast<std::ptrdiff_t>(route_index), route.end()),
-                                     {route.back(), g.length_m(route.back())});
-        }
-        if (preempts(config.signals) && plan.found) {
-          const auto crossings = preemption::signalized_crossings(plan, scenario.plans, t);
-          engine.update_route(kMission, 1, crossings, t);
+        plan = planner::make_route(cost, {ev.route[ev.route_index], ev.pos},
+                                   std::vector<EdgeId>(ev.route.begin() + static_cast<std::ptrdiff_t>(ev.route_index), ev.route.end()),
+                                   {ev.route.back(), g.length_m(ev.route.back())});
+      }
+      if (plan.found) {
+        ev.ahead = preemption::signalized_crossings(g, plan, scenario.plans, t);
+        for (auto& c : ev.ahead) c.node = signal_of(scenario, c.node);
+        if (preempts(config.signals)) engine.update_route(ev.mission, ev.trip.priority, ev.ahead, t);
+      }
+      if (sample) {
+        for (const auto& c : ev.ahead) {
+          TimeSpaceSignal& sig = ev.seen_signals[c.node];
+          if (sig.tls.empty()) sig.tls = scenario.sumo_plan_of.at(c.node)->tls_id;
+          const char light = movement_light(scenario, c, Api::TrafficLight::getRedYellowGreenState(sig.tls));
+          if (sig.states.empty() || sig.states.back().second != light) sig.states.emplace_back(t, light);
         }
       }
     }
     if (preempts(config.signals)) {
       engine.tick(t);
       controller.update(t);
-      for (const auto& ev : engine.take_events()) {
-        if (ev.kind == "started") {
+      for (const auto& event : engine.take_events()) {
+        const auto it = std::find_if(evs.begin(), evs.end(), [&](const EvRun& ev) { return ev.mission == event.mission; });
+        if (event.kind == "started") {
           ++result.preemptions_started;
-          preempted.insert(ev.node);
-        } else if (ev.kind == "released") {
+          if (it != evs.end()) it->preempted.insert(event.node);
+        } else if (event.kind == "released") {
           ++result.preemptions_released;
+        } else if (event.kind == "deferred" && it != evs.end()) {
+          ++it->deferrals;
         }
       }
     }
-    const bool ev_finished = !config.with_ev || ev_done;
+    const bool evs_finished = std::all_of(evs.begin(), evs.end(), [](const EvRun& ev) { return ev.done; });
     const bool lights_home = controller.lights_on_program() == controller.lights_taken_over();
-    if (ev_finished && lights_home && step % 10 == 0 && Api::Simulation::getMinExpectedNumber() == 0) break;
+    if (evs_finished && lights_home && step % 10 == 0 && Api::Simulation::getMinExpectedNumber() == 0) break;
   }
   result.end_time_s = t;
-  result.preempted_signals = preempted.size();
   result.lights_taken_over = controller.lights_taken_over();
   result.lights_back_on_program = controller.lights_on_program();
   result.safety_violations = controller.violations();
   bridge.close();
 
-  add_trip_results(launch.tripinfo, result);
+  std::vector<std::string> ids;
+  for (const EvRun& ev : evs) ids.push_back(ev.id);
+  add_trip_results(launch.tripinfo, ids, result);
+  for (std::size_t k = 0; k < evs.size() && k < result.evs.size(); ++k) {
+    EvOutcome& o = result.evs[k];
+    o.trip = evs[k].trip;
+    o.deferrals = evs[k].deferrals;
+    o.preempted_signals = evs[k].preempted.size();
+    result.deferrals += o.deferrals;
+  }
+  if (!result.evs.empty()) result.preempted_signals = result.evs.front().preempted_signals;
+  if (config.record_time_space && !evs.empty()) {
+    std::vector<TimeSpaceTrack> tracks;
+    for (EvRun& ev : evs) tracks.push_back(std::move(ev.track));
+    write_time_space(config.out_dir / config.run_name, tracks,
+                     fmt::format("{}: {} EV, {} routing, signals {}", scenario.name, tracks.size() == 1 ? "one" : "each",
+                                 to_string(config.routing), to_string(config.signals)));
+  }
   return result;
 }
-
 
 }  // namespace detail
 }  // namespace corridor::sim

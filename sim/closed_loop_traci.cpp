@@ -10,6 +10,7 @@ struct TraciApi {
   using Simulation = libtraci::Simulation;
   using Edge = libtraci::Edge;
   using Lane = libtraci::Lane;
+  using LaneArea = libtraci::LaneArea;
   using Route = libtraci::Route;
   using Vehicle = libtraci::Vehicle;
   using TrafficLight = libtraci::TrafficLight;

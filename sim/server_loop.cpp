@@ -279,7 +279,7 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
   result.lights_taken_over = restored + taken_over.size();
   result.lights_back_on_program = restored;
   bridge.close();
-  add_trip_results(launch.tripinfo, result);
+  add_trip_results(launch.tripinfo, {kEv}, result);
   return result;
 }
 

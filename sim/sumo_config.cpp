@@ -9,6 +9,7 @@
 #include <fstream>
 #include <memory>
 #include <regex>
+#include <sstream>
 
 #include "sim/errors.hpp"
 
@@ -70,6 +71,40 @@ std::pair<int, int> major_minor(const std::string& version) {
   std::smatch m;
   if (!std::regex_search(version, m, re)) return {-1, -1};
   return {std::stoi(m[1].str()), std::stoi(m[2].str())};
+}
+
+struct DetectorParse {
+  std::vector<LaneAreaDetector> detectors;
+};
+
+void on_detector(void* user, const char* name, const char** attrs) {
+  if (std::strcmp(name, "laneAreaDetector") != 0 && std::strcmp(name, "e2Detector") != 0) return;
+  LaneAreaDetector d;
+  for (const char** a = attrs; *a != nullptr; a += 2) {
+    if (std::strcmp(a[0], "id") == 0) d.id = a[1];
+    if (std::strcmp(a[0], "lane") == 0) d.lanes = {a[1]};
+    if (std::strcmp(a[0], "lanes") == 0) {
+      std::istringstream in(a[1]);
+      d.lanes.clear();
+      for (std::string lane; in >> lane;) d.lanes.push_back(lane);
+    }
+  }
+  if (!d.id.empty() && !d.lanes.empty()) static_cast<DetectorParse*>(user)->detectors.push_back(std::move(d));
+}
+
+// The e2 detectors of one additional file; SUMO itself reports a malformed file when it loads it.
+std::vector<LaneAreaDetector> read_lane_area_detectors(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  DetectorParse st;
+  std::unique_ptr<XML_ParserStruct, decltype(&XML_ParserFree)> parser(XML_ParserCreate(nullptr), &XML_ParserFree);
+  XML_SetUserData(parser.get(), &st);
+  XML_SetElementHandler(parser.get(), on_detector, nullptr);
+  if (XML_Parse(parser.get(), text.data(), static_cast<int>(text.size()), 1) == XML_STATUS_ERROR) {
+    throw SimError("additional file '" + file.string() + "' is not valid XML: line " +
+                   std::to_string(XML_GetCurrentLineNumber(parser.get())) + ": " + XML_ErrorString(XML_GetErrorCode(parser.get())));
+  }
+  return std::move(st.detectors);
 }
 
 }  // namespace
@@ -157,6 +192,9 @@ SumoConfig read_sumo_config(const std::filesystem::path& file) {
     }
   }
   if (c.net_file.empty()) throw SimError("'" + file.string() + "' names no net-file: a scenario needs its network");
+  for (const auto& additional : c.additional_files) {
+    for (auto& d : read_lane_area_detectors(additional)) c.lane_area_detectors.push_back(std::move(d));
+  }
   if (c.end_s && *c.end_s <= c.begin_s) {
     throw SimError("'" + file.string() + "': end must come after begin");
   }

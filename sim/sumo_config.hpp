@@ -13,6 +13,12 @@
 
 namespace corridor::sim {
 
+// A lane-area (e2) detector of the user's additional files: what SUMO's LaneArea API reads.
+struct LaneAreaDetector {
+  std::string id;
+  std::vector<std::string> lanes;  // `lane`, or the chain of `lanes`
+};
+
 struct SumoConfig {
   std::filesystem::path file;  // absolute
   std::filesystem::path net_file;
@@ -23,6 +29,9 @@ struct SumoConfig {
   // Output options the file sets (tripinfo-output, summary-output, log, ...) and their values: a
   // run sends each to its own directory so that nothing is written beside the user's files.
   std::map<std::string, std::string> outputs;
+  // The e2 detectors the additional files declare (laneAreaDetector or e2Detector): where present,
+  // their jam lengths are the queue estimate of the approaches they cover.
+  std::vector<LaneAreaDetector> lane_area_detectors;
 };
 
 // Throws SimError, naming the file and the option, for a configuration that is missing, not XML,

@@ -85,7 +85,15 @@ Plan plan_matrix(const SumoExperimentOptions& o) {
       base.congestion_period_s = o.congestion_period_s;
       base.incidents = o.incidents;
       base.backend = o.backend;
+      base.vicinity = o.vicinity;
+      if (o.evs > 1) {
+        base.more_evs = conflicting_ev_trips(*plan.scenario, {base.ev_from, base.ev_to, base.ev_depart_s, 1}, o.evs - 1, seed,
+                                             base.ev_vmax_kmh);
+        base.first_priority = static_cast<int>(o.evs);
+      }
       RunRecord identity;
+      identity.vicinity = o.vicinity;
+      identity.evs = o.evs;
       identity.scenario = plan.net.name;
       identity.volume = volume;
       identity.demand_scale = scale;
@@ -175,6 +183,8 @@ nlohmann::json to_json_record(const RunRecord& r) {
   j["ev_from"] = r.ev_from;
   j["ev_to"] = r.ev_to;
   j["ev_depart_s"] = r.ev_depart_s;
+  j["vicinity"] = r.vicinity;
+  j["ev_count"] = r.evs;
   return j;
 }
 
@@ -197,6 +207,8 @@ RunRecord record_from_json(const nlohmann::json& j, const std::string& source) {
     r.ev_from = j.value("ev_from", std::string{});
     r.ev_to = j.value("ev_to", std::string{});
     r.ev_depart_s = j.at("ev_depart_s").get<double>();
+    r.vicinity = j.value("vicinity", true);
+    r.evs = j.value("ev_count", std::uint32_t{1});
     r.result = j.get<ClosedLoopResult>();
     return r;
   } catch (const nlohmann::json::exception& e) {
@@ -264,7 +276,9 @@ std::size_t emit_sumo_jobs(const SumoExperimentOptions& o, const std::filesystem
                                   "--end-s", fmt::format("{:g}", c.end_s - plan.begin_s),
                                   "--congestion-period-s", fmt::format("{:g}", c.congestion_period_s),
                                   "--incidents", std::to_string(c.incidents),
+                                  "--evs", std::to_string(run.record.evs),
                                   "--result", run.result_file.string()};
+    if (!c.vicinity) args.emplace_back("--route-only");
     if (plan.net.config) {
       args.insert(args.end(), {"--demand-scale", fmt::format("{:g}", c.demand_scale)});
     } else {
@@ -326,7 +340,13 @@ std::vector<ExperimentRow> collect_run_files(std::vector<std::filesystem::path> 
   const std::string scenario = records.front().scenario;
   for (const RunRecord& r : records) {
     if (r.scenario != scenario) throw SimError("the records mix scenarios '" + scenario + "' and '" + r.scenario + "'");
+    if (r.with_ev && (r.vicinity != records.front().vicinity || r.evs != records.front().evs)) {
+      throw SimError("the records mix vicinity-aware and route-only preemption, or numbers of EVs: collect them apart");
+    }
   }
+  const bool vicinity = std::all_of(records.begin(), records.end(), [](const RunRecord& r) { return r.vicinity; });
+  std::uint32_t evs = 1;
+  for (const RunRecord& r : records) evs = std::max(evs, r.evs);
 
   using Key = std::tuple<double, double, std::uint64_t>;  // volume, scale, seed
   std::map<Key, double> baseline;
@@ -352,17 +372,26 @@ std::vector<ExperimentRow> collect_run_files(std::vector<std::filesystem::path> 
   std::string csv =
       "routing,signals,volume,seed,ev_travel_time_s,ev_stops,ev_wait_s,preempted_signals,others_delay_rel,collisions,"
       "teleports,ev_arrived,ev_time_loss_s,route_changes,replans,lights_taken_over,lights_back_on_program,"
-      "safety_violations,others,others_mean_time_loss_s,baseline_time_loss_s,demand_scale,scenario,ev_from,ev_to\n";
+      "safety_violations,others,others_mean_time_loss_s,baseline_time_loss_s,demand_scale,scenario,ev_from,ev_to,"
+      "vicinity,evs,evs_arrived,evs_travel_time_mean_s,deferrals\n";
   for (const ExperimentRow& row : rows) {
     const RunRecord& r = row.run;
-    csv += fmt::format("{},{},{:g},{},{:.1f},{},{:.1f},{},{:.4f},{},{},{},{:.1f},{},{},{},{},{},{},{:.3f},{:.3f},{:g},{},{},{}\n",
+    std::size_t evs_arrived = 0;
+    double evs_time = 0.0;
+    for (const EvOutcome& e : r.result.evs) {
+      evs_arrived += e.arrived ? 1 : 0;
+      evs_time += e.arrived ? e.travel_time_s : 0.0;
+    }
+    csv += fmt::format("{},{},{:g},{},{:.1f},{},{:.1f},{},{:.4f},{},{},{},{:.1f},{},{},{},{},{},{},{:.3f},{:.3f},{:g},{},{},{},"
+                       "{},{},{},{:.1f},{}\n",
                        to_string(r.routing), to_string(r.signals), r.volume, r.seed, r.result.ev_travel_time_s,
                        r.result.ev_stops, r.result.ev_wait_s, r.result.preempted_signals, row.others_delay_rel(),
                        r.result.collisions, r.result.teleports, r.result.ev_arrived ? 1 : 0, r.result.ev_time_loss_s,
                        r.result.route_changes, r.result.replans, r.result.lights_taken_over,
                        r.result.lights_back_on_program, r.result.safety_violations.size(), r.result.others,
                        r.result.others_mean_time_loss_s, row.baseline_time_loss_s, r.demand_scale, r.scenario,
-                       r.ev_from, r.ev_to);
+                       r.ev_from, r.ev_to, r.vicinity ? 1 : 0, r.evs, evs_arrived,
+                       evs_arrived > 0 ? evs_time / static_cast<double>(evs_arrived) : 0.0, r.result.deferrals);
   }
   std::filesystem::create_directories(out_dir);
   write_text(out_dir / "sumo_runs.csv", csv);
@@ -406,10 +435,11 @@ std::vector<ExperimentRow> collect_run_files(std::vector<std::filesystem::path> 
       "ev_stops_median,others_delay_rel_median,others_delay_rel_q1,others_delay_rel_q3,collisions,teleports,"
       "safety_violations,demand_scale\n";
   std::string md = fmt::format(
-      "Scenario `{}`, {} seeds per demand level. EV travel time: median [IQR] in s (an EV that did not arrive counts "
+      "Scenario `{}`, {} seeds per demand level, {} preemption{}. EV travel time: median [IQR] in s (an EV that did not arrive counts "
       "with the time it was still driving). Others: median change of the other vehicles' mean time loss against the "
       "same run without the EV.\n\n| routing / signals |",
-      scenario, seeds.size());
+      scenario, seeds.size(), vicinity ? "vicinity-aware" : "route-only",
+      evs > 1 ? fmt::format(", {} EVs per run (the first EV's figures; every EV's in sumo_runs.csv)", evs) : std::string{});
   for (const auto& d : demands) md += " " + demand_name(d) + " |";
   md += "\n|---|";
   for (std::size_t i = 0; i < demands.size(); ++i) md += "---|";

@@ -39,6 +39,8 @@ struct SumoExperimentOptions {
   std::uint32_t incidents = 2;
   unsigned parallel = 2;
   SumoBackend backend = SumoBackend::traci;
+  bool vicinity = true;   // false: the seed's route-only preemption (--route-only)
+  std::uint32_t evs = 1;  // EVs per run (--evs): the further ones conflict with the first at its lights
 };
 
 // One run's identity and result: what `corridor sim --result FILE` writes and what is collected.
@@ -53,6 +55,8 @@ struct RunRecord {
   std::string ev_from;
   std::string ev_to;
   double ev_depart_s = 0.0;  // simulation time
+  bool vicinity = true;      // vicinity-aware preemption, or route-only
+  std::uint32_t evs = 1;
   ClosedLoopResult result;
 };
 nlohmann::json to_json_record(const RunRecord& r);

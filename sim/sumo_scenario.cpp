@@ -1,5 +1,6 @@
 #include "sim/sumo_scenario.hpp"
 
+#include <map>
 #include <memory>
 
 namespace corridor::sim {
@@ -16,13 +17,24 @@ std::unique_ptr<SumoScenario> load_sumo_scenario(const ScenarioNet& scenario_net
   }
   maps::SumoGraph graph = maps::build_sumo_graph(net);
   auto s = std::unique_ptr<SumoScenario>(new SumoScenario{scenario_net.name, scenario_net.dir, scenario_net.net,
-                                                          std::move(net), std::move(graph), {}, {}, {}, {},
+                                                          std::move(net), std::move(graph), {}, {}, {}, {}, {}, {},
                                                           scenario_net.config});
   s->sumo_plans = maps::sumo_signal_plans(s->net);
   std::unordered_map<NodeId, std::size_t> tls_of;
   s->plans = maps::plans_by_node(s->graph, s->net, s->sumo_plans, &tls_of);
   for (const auto& [node, index] : tls_of) s->sumo_plan_of[node] = &s->sumo_plans[index];
   for (const auto& logic : s->net.tl_logics) s->tls_phases[logic.id] = logic.phases;
+  std::map<std::size_t, NodeId> key_of_tls;
+  for (const auto& [node, index] : tls_of) {
+    auto [it, fresh] = key_of_tls.emplace(index, node);
+    if (!fresh && node < it->second) it->second = node;
+  }
+  for (const auto& [node, index] : tls_of) s->signal_node[node] = key_of_tls.at(index);
+  for (const auto& [index, key] : key_of_tls) {
+    maps::SignalPlan plan = s->plans.at(key);
+    plan.node = key;
+    s->signal_plans.emplace(key, std::move(plan));
+  }
   return s;
 }
 

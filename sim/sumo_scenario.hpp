@@ -20,11 +20,22 @@ struct SumoScenario {
   maps::SumoNet net;
   maps::SumoGraph graph;
   std::vector<maps::SumoSignalPlan> sumo_plans;
-  std::unordered_map<NodeId, maps::SignalPlan> plans;
+  std::unordered_map<NodeId, maps::SignalPlan> plans;  // every stop line a light controls
+  // One plan per SUMO traffic light, keyed by its lowest stop-line node: what the preemption engine
+  // and the signal controller hold, so that claims on one light from different approaches are
+  // arbitrated against each other and one controller alone sets the light's state.
+  std::unordered_map<NodeId, maps::SignalPlan> signal_plans;
+  std::unordered_map<NodeId, NodeId> signal_node;  // stop-line node -> its light's key in signal_plans
   std::unordered_map<NodeId, const maps::SumoSignalPlan*> sumo_plan_of;
   std::unordered_map<std::string, std::vector<maps::SumoTlPhase>> tls_phases;
   std::optional<SumoConfig> config;  // a user's scenario: SUMO runs its configuration
 };
+
+// The light's key (signal_plans) of a stop-line node; the node itself when no light controls it.
+[[nodiscard]] inline NodeId signal_of(const SumoScenario& s, NodeId stop_line) {
+  const auto it = s.signal_node.find(stop_line);
+  return it == s.signal_node.end() ? stop_line : it->second;
+}
 
 // Throws MapLoadError / SimError for an unreadable or unusable net. With a configuration, the
 // traffic-light programs of its additional files replace the net's (SUMO runs the last program

@@ -85,6 +85,24 @@ TEST_F(SumoConfigTest, EachBadCaseNamesTheFileAndTheOption) {
   EXPECT_NE(error_of(dir_ / "broken.sumocfg").find("XML error"), std::string::npos);
 }
 
+// The user's lane-area detectors, in both of SUMO's spellings and with a lane chain; other
+// detectors are not lane-area ones. A broken additional file is a clear error.
+TEST_F(SumoConfigTest, ReadsTheLaneAreaDetectorsOfTheAdditionalFiles) {
+  write("det.add.xml",
+        "<additional><laneAreaDetector id=\"q1\" lane=\"e1_0\" pos=\"0\" length=\"50\" file=\"o.xml\"/>"
+        "<e2Detector id=\"q2\" lanes=\"e2_0 e3_0\" pos=\"0\" endPos=\"10\" file=\"o.xml\"/>"
+        "<inductionLoop id=\"loop\" lane=\"e4_0\" pos=\"1\" file=\"o.xml\"/></additional>");
+  const auto c = read_sumo_config(cfg("<net-file value=\"sub/city.net.xml\"/><additional-files value=\"det.add.xml\"/>"));
+  ASSERT_EQ(c.lane_area_detectors.size(), 2u);
+  EXPECT_EQ(c.lane_area_detectors[0].id, "q1");
+  EXPECT_EQ(c.lane_area_detectors[0].lanes, std::vector<std::string>{"e1_0"});
+  EXPECT_EQ(c.lane_area_detectors[1].id, "q2");
+  EXPECT_EQ(c.lane_area_detectors[1].lanes, (std::vector<std::string>{"e2_0", "e3_0"}));
+  write("det.add.xml", "<additional><laneAreaDetector");
+  EXPECT_NE(error_of(cfg("<net-file value=\"sub/city.net.xml\"/><additional-files value=\"det.add.xml\"/>")).find("det.add.xml"),
+            std::string::npos);
+}
+
 TEST(SumoTime, SecondsAndClockForms) {
   EXPECT_EQ(parse_sumo_time("25200"), 25200.0);
   EXPECT_EQ(parse_sumo_time("0.5"), 0.5);

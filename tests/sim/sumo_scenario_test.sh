@@ -46,11 +46,20 @@ logic = re.sub(r'programID="[^"]*"', 'programID="user"', logic, count=1)
 open(sys.argv[2], "w").write("<additional>\n" + logic + "\n</additional>\n")
 PY
 lane=$(grep -o '<lane id="[^":]*_0"' "$user/net/cologne8.net.xml" | head -1 | sed 's/<lane id="//; s/"//')
-cat > "$user/detectors.add.xml" <<XML
-<additional>
-  <inductionLoop id="d0" lane="$lane" pos="1" period="60" file="detector_out.xml"/>
-</additional>
-XML
+# An induction loop, and lane-area (e2) detectors on the approach lanes of the net's first traffic
+# light: their jam lengths become the queue estimate there.
+/usr/bin/python3 - "$user/net/cologne8.net.xml" "$lane" > "$user/detectors.add.xml" <<'PY'
+import sys, xml.etree.ElementTree as ET
+net = ET.parse(sys.argv[1]).getroot()
+length = {l.get("id"): float(l.get("length")) for e in net.iter("edge") for l in e.iter("lane")}
+tls = next(j for j in net.iter("junction") if j.get("type") == "traffic_light")
+print("<additional>")
+print(f'  <inductionLoop id="d0" lane="{sys.argv[2]}" pos="1" period="60" file="detector_out.xml"/>')
+for i, lane in enumerate(l for l in tls.get("incLanes").split() if not l.startswith(":")):
+    print(f'  <laneAreaDetector id="e2_{i}" lane="{lane}" pos="0" length="{length[lane] - 0.5:.2f}" friendlyPos="true" '
+          f'period="60" file="e2_out.xml"/>')
+print("</additional>")
+PY
 cat > "$user/scenario.sumocfg" <<'XML'
 <configuration>
   <input>
@@ -93,7 +102,9 @@ if a["collisions"] != 0: problems.append(f"{a['collisions']} collisions")
 if a["safety_violations"]: problems.append("safety violations: " + "; ".join(a["safety_violations"][:3]))
 if a["ev_depart_s"] != 25320: problems.append(f"the EV departed at {a['ev_depart_s']}, not begin + 120 = 25320")
 if a["others"] < 200: problems.append(f"only {a['others']} other vehicles: the scenario's demand did not run")
-print(f"user scenario: travel {a['ev_travel_time_s']} s, preempted {a['preempted_signals']}, others {a['others']}")
+if a["approaches_with_detectors"] < 1: problems.append("no approach took its queue from the user's e2 detectors")
+print(f"user scenario: travel {a['ev_travel_time_s']} s, preempted {a['preempted_signals']}, others {a['others']}, "
+      f"approaches on e2 detectors {a['approaches_with_detectors']}")
 for p in problems: print("FAIL user scenario:", p)
 sys.exit(1 if problems else 0)
 PY
