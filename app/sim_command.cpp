@@ -46,6 +46,7 @@ struct SimOptions {
   std::vector<std::string> gps_outages;
   std::string token;
   std::uint32_t evs = 1;
+  double inject_vph = 0.0;
   bool route_only = false;
   bool time_space = false;
 };
@@ -101,6 +102,8 @@ void run_sim(const SimOptions& o) {
     c.first_priority = static_cast<int>(o.evs);
   }
   c.vicinity = !o.route_only;
+  if (!(o.inject_vph >= 0.0 && o.inject_vph <= 5000.0)) throw UsageError("--inject-vph must be in [0, 5000] vehicles/hour");
+  c.inject_on_route_vph = o.inject_vph;
   c.record_time_space = o.time_space;
   c.demand_scale = o.demand_scale;
   c.seed = o.seed;
@@ -157,7 +160,8 @@ void run_sim(const SimOptions& o) {
   record.with_ev = c.with_ev;
   record.routing = c.routing;
   record.signals = c.signals;
-  record.volume = net.config ? 0.0 : o.volume;
+  record.volume = o.inject_vph > 0.0 ? o.inject_vph : (net.config ? 0.0 : o.volume);
+  record.inject_on_route = o.inject_vph > 0.0;
   record.demand_scale = c.demand_scale;
   record.seed = o.seed;
   record.ev_from = c.ev_from;
@@ -183,7 +187,7 @@ void run_sim(const SimOptions& o) {
 void register_sim_command(CLI::App& app) {
   auto o = std::make_shared<SimOptions>();
   auto* cmd = app.add_subcommand("sim", "One closed-loop SUMO run with an emergency vehicle; prints JSON");
-  cmd->add_option("--scenario", o->scenario, "grid, a SUMO configuration (.sumocfg), a SUMO .net.xml, or an OSM file")
+  cmd->add_option("--scenario", o->scenario, "grid, nema-grid, a SUMO configuration (.sumocfg), a SUMO .net.xml, or an OSM file")
       ->capture_default_str();
   cmd->add_option("--work-dir", o->work_dir, "scenario files and run outputs")->capture_default_str();
   cmd->add_option("--volume", o->volume, "background vehicles per hour")->capture_default_str();
@@ -219,6 +223,9 @@ void register_sim_command(CLI::App& app) {
                   "with falling priority")
       ->capture_default_str();
   cmd->add_flag("--route-only", o->route_only, "the seed's route-only preemption, without the vicinity rules");
+  cmd->add_option("--inject-vph", o->inject_vph,
+                  "the seed's Fig. 11: a flow of this many vehicles/hour along the EV's static route")
+      ->capture_default_str();
   cmd->add_flag("--time-space", o->time_space,
                 "write the EVs' trajectories and lights (RUN.ev_trajectory.csv, RUN.ev_signals.csv, RUN.time_space.svg)");
   cmd->callback([o] { run_sim(*o); });
@@ -245,7 +252,7 @@ void register_sumo_experiment(CLI::App& experiment) {
   auto end_s = std::make_shared<std::optional<double>>();
   auto* cmd = experiment.add_subcommand(
       "sumo", "Closed-loop SUMO matrix: routing x signal strategies over demand levels and seeds; run here, or emit and collect");
-  cmd->add_option("--scenario", o->scenario, "grid, a SUMO configuration (.sumocfg), a .net.xml, or an OSM file")
+  cmd->add_option("--scenario", o->scenario, "grid, nema-grid, a SUMO configuration (.sumocfg), a .net.xml, or an OSM file")
       ->capture_default_str();
   cmd->add_option("--volumes", o->volumes, "generated scenarios: background volumes, vehicles/hour, comma-separated")
       ->delimiter(',')
@@ -275,6 +282,9 @@ void register_sumo_experiment(CLI::App& experiment) {
   cmd->add_option("--evs", o->evs, "EVs per run (the further ones conflict with the first at its lights)")->capture_default_str();
   auto route_only = std::make_shared<bool>(false);
   cmd->add_flag("--route-only", *route_only, "the seed's route-only preemption, without the vicinity rules");
+  cmd->add_flag("--inject-on-route", o->inject_on_route,
+                "the seed's Fig. 11: --volumes are injected along each EV's static route, over --background-vph");
+  cmd->add_option("--background-vph", o->background_vph, "with --inject-on-route: background vehicles/hour")->capture_default_str();
   cmd->callback([o, signals, routings, emit_jobs, collect, end_s, libsumo, route_only] {
     if (!emit_jobs->empty() && !collect->empty()) throw UsageError("--emit-jobs and --collect are two steps: give one");
     if (!collect->empty()) {

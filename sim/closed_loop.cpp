@@ -126,6 +126,28 @@ SumoLaunch launch_for(const SumoScenario& scenario, const ClosedLoopConfig& conf
       launch.options.emplace_back(option, (config.out_dir / (config.run_name + "." + std::filesystem::path(value).filename().string())).string());
     }
   }
+  if (config.inject_on_route_vph > 0.0) {
+    const auto& g = scenario.graph.graph;
+    const planner::CostOverlay free_flow(g);
+    const planner::TravelCost cost(g, free_flow, {config.ev_vmax_kmh / 3.6});
+    planner::OneToOneSearch search;
+    const auto starts = points_on(scenario.graph, config.ev_from, 0.0);
+    const auto goals = points_on(scenario.graph, config.ev_to, std::nullopt);
+    if (starts.empty() || goals.empty()) throw SimError("traffic cannot be injected on the route of unknown edges");
+    const planner::Route r = search.run(planner::SearchSpace(cost, starts, goals), true);
+    if (!r.found) throw SimError("the EV's goal cannot be reached from its start");
+    std::string edges;
+    for (const auto& id : sumo_ids(scenario.graph, r.edges)) edges += (edges.empty() ? "" : " ") + id;
+    const auto file = config.out_dir / (config.run_name + ".inject.rou.xml");
+    std::ofstream out(file, std::ios::trunc);
+    out << fmt::format(
+        "<routes>\n  <route id=\"inject_route\" edges=\"{}\"/>\n"
+        "  <flow id=\"inject\" route=\"inject_route\" begin=\"{:g}\" end=\"{:g}\" vehsPerHour=\"{:g}\" "
+        "departLane=\"best\" departSpeed=\"max\"/>\n</routes>\n",
+        edges, std::max(0.0, config.ev_depart_s - 600.0), config.end_s, config.inject_on_route_vph);
+    if (!out) throw SimError("cannot write " + file.string());
+    launch.routes.push_back(file);
+  }
   const auto types = config.out_dir / (config.run_name + ".ev_types.add.xml");
   write_ev_types(types, config.ev_vmax_kmh / 3.6);
   launch.additional.push_back(types);

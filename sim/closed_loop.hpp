@@ -77,6 +77,9 @@ struct ClosedLoopConfig {
   // enough that the EV meets no queue, and flush a link about to spill back into the junction
   // before (preemption::VicinityConfig). Off: the seed's route-only preemption.
   bool vicinity = true;
+  // The seed's Fig. 11 protocol: a flow of this many vehicles/hour along the first EV's free-flow
+  // (static) route, from 10 min before it departs to the end; 0: none.
+  double inject_on_route_vph = 0.0;
   // Writes <run>.ev_trajectory.csv, <run>.ev_signals.csv and <run>.time_space.svg.
   bool record_time_space = false;
 };

@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 
 #include <cstdlib>
+#include <fstream>
+#include <optional>
 
 #include "maps/sumo_net.hpp"
 #include "sim/errors.hpp"
@@ -59,6 +61,86 @@ ScenarioNet build_grid_net(const std::filesystem::path& dir, const GridSpec& spe
   return net;
 }
 
+namespace {
+
+// One SUMO state per NEMA phase: a link is green when its movement is served, 'G' when no other
+// served movement conflicts with it and 'g' (yield) otherwise; links without a NEMA movement (none
+// on a plain grid) stay red.
+std::string nema_state(const maps::SignalPlan& plan, const maps::Phase& phase, const std::vector<std::optional<std::size_t>>& link_movement) {
+  std::string state(link_movement.size(), 'r');
+  for (std::size_t i = 0; i < link_movement.size(); ++i) {
+    if (!link_movement[i] || !phase.serves(*link_movement[i])) continue;
+    bool yields = false;
+    for (std::size_t m = 0; m < plan.movements.size(); ++m) yields = yields || (phase.serves(m) && plan.conflicts(*link_movement[i], m));
+    state[i] = yields ? 'g' : 'G';
+  }
+  return state;
+}
+
+// The SUMO program of a NEMA plan: each step's green, then yellow for the links that lose green,
+// then all-red for them, before the next step.
+std::string nema_tl_logic(const std::string& tls, const maps::SignalPlan& plan,
+                          const std::vector<std::optional<std::size_t>>& link_movement) {
+  std::string xml = fmt::format("  <tlLogic id=\"{}\" type=\"static\" programID=\"0\" offset=\"0\">\n", tls);
+  for (std::size_t k = 0; k < plan.program.size(); ++k) {
+    const auto& step = plan.program[k];
+    const auto& next = plan.program[(k + 1) % plan.program.size()];
+    const std::string green = nema_state(plan, plan.phases[step.phase], link_movement);
+    const std::string after = nema_state(plan, plan.phases[next.phase], link_movement);
+    std::string yellow = green, red = green;
+    for (std::size_t i = 0; i < green.size(); ++i) {
+      if (green[i] != 'r' && after[i] == 'r') yellow[i] = 'y', red[i] = 'r';
+    }
+    xml += fmt::format("    <phase duration=\"{:g}\" state=\"{}\"/>\n", step.green_s, green);
+    if (yellow == green) continue;  // the next step keeps every green: no clearance needed
+    xml += fmt::format("    <phase duration=\"{:g}\" state=\"{}\"/>\n", plan.yellow_s, yellow);
+    xml += fmt::format("    <phase duration=\"{:g}\" state=\"{}\"/>\n", plan.all_red_s, red);
+  }
+  return xml + "  </tlLogic>\n";
+}
+
+}  // namespace
+
+ScenarioNet build_nema_grid_net(const std::filesystem::path& dir, const GridSpec& spec) {
+  const ScenarioNet base = build_grid_net(dir, spec);
+  const std::string name = fmt::format("nema_grid{}x{}", spec.blocks, spec.blocks);
+  ScenarioNet net{name, dir, dir / (name + ".net.xml"), std::nullopt};
+  if (up_to_date(net.net, base.net)) return net;
+  const maps::SumoNet sumo = maps::read_sumo_net(base.net);
+  std::string tll = "<tlLogics>\n";
+  for (const maps::SumoTlLogic& logic : sumo.tl_logics) {
+    const maps::SumoJunction* junction = sumo.junction(logic.id);
+    if (junction == nullptr) throw SimError("grid light '" + logic.id + "' has no junction of that id");
+    const auto side_of = [&](const std::string& other) {
+      const maps::SumoJunction* j = sumo.junction(other);
+      if (j == nullptr) throw SimError("grid edge to an unknown junction '" + other + "'");
+      return maps::compass_side(junction->position, j->position);
+    };
+    std::vector<const maps::SumoConnection*> links;
+    std::uint8_t legs = 0;
+    for (const maps::SumoConnection& c : sumo.connections) {
+      if (c.tl != logic.id || c.link_index < 0) continue;
+      if (links.size() <= static_cast<std::size_t>(c.link_index)) links.resize(static_cast<std::size_t>(c.link_index) + 1, nullptr);
+      links[static_cast<std::size_t>(c.link_index)] = &c;
+      legs |= static_cast<std::uint8_t>(1u << static_cast<int>(side_of(sumo.edge(c.from)->from)));
+      legs |= static_cast<std::uint8_t>(1u << static_cast<int>(side_of(sumo.edge(c.to)->to)));
+    }
+    const maps::SignalPlan plan = maps::make_nema_plan(NodeId{0}, legs);
+    std::vector<std::optional<std::size_t>> link_movement(links.size());
+    for (std::size_t i = 0; i < links.size(); ++i) {
+      if (links[i] == nullptr) continue;
+      link_movement[i] = plan.movement_index(side_of(sumo.edge(links[i]->from)->from), side_of(sumo.edge(links[i]->to)->to));
+    }
+    tll += nema_tl_logic(logic.id, plan, link_movement);
+  }
+  tll += "</tlLogics>\n";
+  const auto tll_file = dir / (name + ".tll.xml");
+  std::ofstream(tll_file, std::ios::trunc) << tll;
+  run_tool({"netconvert", "--sumo-net-file", base.net.string(), "--tllogic-files", tll_file.string(), "-o", net.net.string()},
+           dir / "netconvert_nema.log");
+  return net;
+}
+
 ScenarioNet build_osm_net(const std::filesystem::path& dir, const std::filesystem::path& osm_file) {
   if (!std::filesystem::exists(osm_file)) throw SimError("OSM file '" + osm_file.string() + "' does not exist");
   prepare(dir);
@@ -80,6 +162,7 @@ ScenarioNet build_osm_net(const std::filesystem::path& dir, const std::filesyste
 
 ScenarioNet build_scenario_net(const std::string& scenario, const std::filesystem::path& dir) {
   if (scenario == "grid") return build_grid_net(dir, GridSpec{});
+  if (scenario == "nema-grid") return build_nema_grid_net(dir, GridSpec{});
   const std::filesystem::path file(scenario);
   if (!std::filesystem::exists(file)) {
     throw SimError("--scenario must be grid, a .sumocfg, a .net.xml, or an OSM file (.osm, .osm.gz, .osm.pbf); '" +

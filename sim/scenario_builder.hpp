@@ -29,11 +29,17 @@ struct ScenarioNet {
 // A grid like the seed paper's: two lanes per direction, a traffic light at every junction.
 ScenarioNet build_grid_net(const std::filesystem::path& dir, const GridSpec& spec);
 
+// The seed's VISSIM grid (its Fig. 11): the same grid, but every light runs the seed's Fig. 3 NEMA
+// dual-ring 8-phase program (maps::make_nema_plan: protected lefts, 3 s yellow, 2 s all-red),
+// written as SUMO programs that replace netgenerate's (same program id) in a net compiled by
+// netconvert. Scenario name "nema-grid".
+ScenarioNet build_nema_grid_net(const std::filesystem::path& dir, const GridSpec& spec);
+
 // netconvert with the options of the issue (signals guessed and joined, passenger roads only).
 // A .pbf is first converted to .osm with osmium-tool, since netconvert does not read PBF.
 ScenarioNet build_osm_net(const std::filesystem::path& dir, const std::filesystem::path& osm_file);
 
-// "grid" (the default grid), a user's SUMO configuration (.sumocfg), a SUMO .net.xml used as it
+// "grid" (the default grid), "nema-grid" (the same with NEMA programs), a user's SUMO configuration (.sumocfg), a SUMO .net.xml used as it
 // is, or an OSM file (.osm, .osm.gz, .pbf). A configuration's or net's files are read where they
 // are and never written; `dir` receives what runs produce. Throws SimError for a missing or
 // unusable file, and for a net newer than the installed SUMO.

@@ -60,6 +60,10 @@ Plan plan_matrix(const SumoExperimentOptions& o) {
   const auto& config = plan.net.config;
   if (config && o.demand_scales.empty()) throw SimError("a .sumocfg scenario needs at least one demand scale");
   if (!config && o.volumes.empty()) throw SimError("a generated scenario needs at least one volume");
+  if (config && o.inject_on_route) throw SimError("--inject-on-route is for generated scenarios; a .sumocfg brings its own demand");
+  if (o.inject_on_route && !(o.background_vph > 0.0 && o.background_vph <= 20000.0)) {
+    throw SimError("--background-vph must be in (0, 20000] vehicles/hour");
+  }
   plan.begin_s = config ? config->begin_s : 0.0;
   const double end_after_begin = o.end_s ? *o.end_s : (config && config->end_s ? *config->end_s - plan.begin_s : 2400.0);
   if (!(end_after_begin > o.ev_depart_s && o.ev_depart_s >= 0.0)) {
@@ -77,7 +81,11 @@ Plan plan_matrix(const SumoExperimentOptions& o) {
     for (std::uint64_t seed = o.first_seed; seed < o.first_seed + o.seeds; ++seed) {
       ClosedLoopConfig base;
       std::tie(base.ev_from, base.ev_to) = pick_ev_trip(*plan.scenario, seed);
-      if (!config) base.background_routes = build_background_demand(plan.net, {volume, o.demand_end_s, seed});
+      if (!config) {
+        base.background_routes =
+            build_background_demand(plan.net, {o.inject_on_route ? o.background_vph : volume, o.demand_end_s, seed});
+      }
+      if (o.inject_on_route) base.inject_on_route_vph = volume;
       base.demand_scale = scale;
       base.ev_depart_s = plan.begin_s + o.ev_depart_s;
       base.end_s = plan.begin_s + end_after_begin;
@@ -93,6 +101,7 @@ Plan plan_matrix(const SumoExperimentOptions& o) {
       }
       RunRecord identity;
       identity.vicinity = o.vicinity;
+      identity.inject_on_route = o.inject_on_route;
       identity.evs = o.evs;
       identity.scenario = plan.net.name;
       identity.volume = volume;
@@ -184,6 +193,7 @@ nlohmann::json to_json_record(const RunRecord& r) {
   j["ev_to"] = r.ev_to;
   j["ev_depart_s"] = r.ev_depart_s;
   j["vicinity"] = r.vicinity;
+  j["inject_on_route"] = r.inject_on_route;
   j["ev_count"] = r.evs;
   return j;
 }
@@ -208,6 +218,7 @@ RunRecord record_from_json(const nlohmann::json& j, const std::string& source) {
     r.ev_to = j.value("ev_to", std::string{});
     r.ev_depart_s = j.at("ev_depart_s").get<double>();
     r.vicinity = j.value("vicinity", true);
+    r.inject_on_route = j.value("inject_on_route", false);
     r.evs = j.value("ev_count", std::uint32_t{1});
     r.result = j.get<ClosedLoopResult>();
     return r;
@@ -282,8 +293,9 @@ std::size_t emit_sumo_jobs(const SumoExperimentOptions& o, const std::filesystem
     if (plan.net.config) {
       args.insert(args.end(), {"--demand-scale", fmt::format("{:g}", c.demand_scale)});
     } else {
-      args.insert(args.end(), {"--volume", fmt::format("{:g}", run.record.volume), "--background-routes",
-                               c.background_routes.string()});
+      args.insert(args.end(), {"--volume", fmt::format("{:g}", o.inject_on_route ? o.background_vph : run.record.volume),
+                               "--background-routes", c.background_routes.string()});
+      if (o.inject_on_route) args.insert(args.end(), {"--inject-vph", fmt::format("{:g}", run.record.volume)});
     }
     if (!c.with_ev) args.emplace_back("--no-ev");
     if (c.backend == SumoBackend::libsumo) args.emplace_back("--libsumo");
@@ -508,7 +520,10 @@ std::vector<ExperimentRow> collect_run_files(std::vector<std::filesystem::path> 
   }
   write_text(out_dir / "sumo_summary.csv", summary);
   write_text(out_dir / "sumo_summary.md", md);
-  const std::string x_label = scaled ? "demand scale (x the scenario's own demand)" : "background volume (vehicles/hour)";
+  const bool injected = std::any_of(rows.begin(), rows.end(), [](const ExperimentRow& r) { return r.run.inject_on_route; });
+  const std::string x_label = scaled     ? "demand scale (x the scenario's own demand)"
+                              : injected ? "volume injected on the EV's static route (vehicles/hour)"
+                                         : "background volume (vehicles/hour)";
   write_text(out_dir / "sumo_travel_time.svg",
              planner::render_line_chart({fmt::format("{}: EV travel time against demand", scenario), x_label,
                                          "median EV travel time (s)"},

@@ -40,6 +40,10 @@ struct SumoExperimentOptions {
   unsigned parallel = 2;
   SumoBackend backend = SumoBackend::traci;
   bool vicinity = true;   // false: the seed's route-only preemption (--route-only)
+  // The seed's Fig. 11 protocol (--inject-on-route): `volumes` are injected along each EV's static
+  // route, over background traffic of background_vph.
+  bool inject_on_route = false;
+  double background_vph = 400.0;
   std::uint32_t evs = 1;  // EVs per run (--evs): the further ones conflict with the first at its lights
 };
 
@@ -49,7 +53,10 @@ struct RunRecord {
   bool with_ev = true;
   EvRouting routing = EvRouting::dynamic_route;
   EvSignals signals = EvSignals::corridor;
-  double volume = 0.0;        // generated background veh/h; 0 for a scenario's own demand
+  // Generated background veh/h (0 for a scenario's own demand); with inject_on_route, the volume
+  // injected on the EV's static route.
+  double volume = 0.0;
+  bool inject_on_route = false;
   double demand_scale = 1.0;  // SUMO's --scale
   std::uint64_t seed = 1;
   std::string ev_from;
