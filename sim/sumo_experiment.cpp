@@ -507,11 +507,15 @@ std::vector<ExperimentRow> collect_run_files(std::vector<std::filesystem::path> 
     const double none = median(EvRouting::static_route, EvSignals::none);
     const double blue = median(EvRouting::static_route, EvSignals::bluelight);
     const Cell& c = cells.at({best->first, best->second, d});
-    md += fmt::format("- {}: {} {:.0f} s; {:+.1f}% against static / none ({:.0f} s), {:+.1f}% against static / bluelight "
-                      "({:.0f} s); others' delay {:+.1f}% [IQR {:+.1f}, {:+.1f}]; {} of {} EVs arrived; {} collisions, "
-                      "{} safety violations\n",
-                      demand_name(d), label(best->first, best->second), b, 100.0 * (b / none - 1.0), none,
-                      100.0 * (b / blue - 1.0), blue, 100.0 * quantile(c.rel, 0.5), 100.0 * quantile(c.rel, 0.25),
+    // A matrix without a baseline strategy (say, only the corridor ones) says so instead of NaN.
+    const auto against = [&](double base, const char* name) {
+      return std::isnan(base) ? fmt::format("no {} run in this matrix", name)
+                              : fmt::format("{:+.1f}% against {} ({:.0f} s)", 100.0 * (b / base - 1.0), name, base);
+    };
+    md += fmt::format("- {}: {} {:.0f} s; {}, {}; others' delay {:+.1f}% [IQR {:+.1f}, {:+.1f}]; {} of {} EVs arrived; "
+                      "{} collisions, {} safety violations\n",
+                      demand_name(d), label(best->first, best->second), b, against(none, "static / none"),
+                      against(blue, "static / bluelight"), 100.0 * quantile(c.rel, 0.5), 100.0 * quantile(c.rel, 0.25),
                       100.0 * quantile(c.rel, 0.75), c.arrived, c.tt.size(), c.collisions, c.violations);
   }
   if (!failed.empty()) {
