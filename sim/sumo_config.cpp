@@ -73,6 +73,15 @@ std::pair<int, int> major_minor(const std::string& version) {
   return {std::stoi(m[1].str()), std::stoi(m[2].str())};
 }
 
+// Runs expat over `text` with these handlers: the error ("line N: message") when it is not XML.
+std::optional<std::string> parse_xml(const std::string& text, void* user, XML_StartElementHandler start, XML_EndElementHandler end) {
+  std::unique_ptr<XML_ParserStruct, decltype(&XML_ParserFree)> parser(XML_ParserCreate(nullptr), &XML_ParserFree);
+  XML_SetUserData(parser.get(), user);
+  XML_SetElementHandler(parser.get(), start, end);
+  if (XML_Parse(parser.get(), text.data(), static_cast<int>(text.size()), 1) != XML_STATUS_ERROR) return std::nullopt;
+  return "line " + std::to_string(XML_GetCurrentLineNumber(parser.get())) + ": " + XML_ErrorString(XML_GetErrorCode(parser.get()));
+}
+
 struct DetectorParse {
   std::vector<LaneAreaDetector> detectors;
 };
@@ -97,12 +106,8 @@ std::vector<LaneAreaDetector> read_lane_area_detectors(const std::filesystem::pa
   std::ifstream in(file, std::ios::binary);
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   DetectorParse st;
-  std::unique_ptr<XML_ParserStruct, decltype(&XML_ParserFree)> parser(XML_ParserCreate(nullptr), &XML_ParserFree);
-  XML_SetUserData(parser.get(), &st);
-  XML_SetElementHandler(parser.get(), on_detector, nullptr);
-  if (XML_Parse(parser.get(), text.data(), static_cast<int>(text.size()), 1) == XML_STATUS_ERROR) {
-    throw SimError("additional file '" + file.string() + "' is not valid XML: line " +
-                   std::to_string(XML_GetCurrentLineNumber(parser.get())) + ": " + XML_ErrorString(XML_GetErrorCode(parser.get())));
+  if (const auto error = parse_xml(text, &st, on_detector, nullptr)) {
+    throw SimError("additional file '" + file.string() + "' is not valid XML: " + *error);
   }
   return std::move(st.detectors);
 }
@@ -146,13 +151,8 @@ SumoConfig read_sumo_config(const std::filesystem::path& file) {
   if (!in.good() && !in.eof()) throw SimError("cannot read '" + file.string() + "'");
 
   ConfigParse st;
-  std::unique_ptr<XML_ParserStruct, decltype(&XML_ParserFree)> parser(XML_ParserCreate(nullptr), &XML_ParserFree);
-  XML_SetUserData(parser.get(), &st);
-  XML_SetElementHandler(parser.get(), on_start, on_end);
-  if (XML_Parse(parser.get(), text.data(), static_cast<int>(text.size()), 1) == XML_STATUS_ERROR) {
-    throw SimError("'" + file.string() + "' is not a valid SUMO configuration: XML error at line " +
-                   std::to_string(XML_GetCurrentLineNumber(parser.get())) + ": " +
-                   XML_ErrorString(XML_GetErrorCode(parser.get())));
+  if (const auto error = parse_xml(text, &st, on_start, on_end)) {
+    throw SimError("'" + file.string() + "' is not a valid SUMO configuration: XML error at " + *error);
   }
 
   SumoConfig c;
