@@ -129,12 +129,15 @@ bool PreemptionEngine::time_entry(ScheduleEntry& e, const Crossing& c, const Cro
   if (auto it = measurements_.find(c.node); it != measurements_.end()) measured = it->second[static_cast<int>(from)];
   if (queue != nullptr) measured.queue_veh = queue->queue_now(from);
   e.congestion = classify_congestion(measured, config_.congestion);
-  // A link about to spill back is flushed with every movement of its approach, whatever turns the
-  // queued vehicles make. The transition estimate for the rule is the worst case, a full Trans.
+  // A standing queue in front of the vehicle, or a link about to spill back, is flushed with every
+  // movement of its approach, whatever turns the queued vehicles make: a queued vehicle waiting on
+  // a red turn would otherwise block the vehicle's lane for the whole hold (seen in cologne8,
+  // where the EV stood 180 s at its own green). The transition estimate for the rules is the worst
+  // case, a full Trans.
   const double full_trans =
       transition_time_s(controller_.remaining_min_green_s(c.node, now_s), plan.yellow_s, plan.all_red_s);
   const std::optional<VicinityStart> vicinity = vicinity_start(c, previous, full_trans, now_s);
-  if (vicinity && vicinity->spillback) e.congestion = CongestionLevel::high;
+  if (vicinity) e.congestion = CongestionLevel::high;
   // Measured demand per movement (the queue on its approach) where detectors report it.
   std::vector<double> demand(plan.movements.size(), std::nan(""));
   if (auto it = queues_.find(c.node); it != queues_.end()) {
@@ -296,7 +299,7 @@ void PreemptionEngine::update_route(MissionId mission, int priority, std::span<c
     on_route.push_back(c.node);
     ScheduleEntry* existing = nullptr;
     for (auto& e : entries) {
-      if (e->node == c.node && is_live(*e)) existing = e.get();
+      if (e->node == c.node && is_live(*e) && !e->flush_for) existing = e.get();
     }
     if (existing != nullptr) {
       const double before = existing->natural_start_s;
@@ -320,8 +323,15 @@ void PreemptionEngine::update_route(MissionId mission, int priority, std::span<c
     }
     touched.push_back(c.node);
   }
+  const std::vector<std::pair<NodeId, NodeId>> flushes = update_flushes(mission, priority, crossings, now_s, touched);
   for (auto& e : entries) {
-    if (is_live(*e) && std::find(on_route.begin(), on_route.end(), e->node) == on_route.end()) {
+    if (!is_live(*e)) continue;
+    if (e->flush_for) {
+      if (std::find(flushes.begin(), flushes.end(), std::pair(e->node, *e->flush_for)) == flushes.end()) {
+        finish(*e, EntryState::cancelled, now_s, "reason=side_link_no_longer_spilling");
+        touched.push_back(e->node);
+      }
+    } else if (std::find(on_route.begin(), on_route.end(), e->node) == on_route.end()) {
       finish(*e, EntryState::cancelled, now_s, "reason=route_left_intersection");
       touched.push_back(e->node);
     }
@@ -332,15 +342,92 @@ void PreemptionEngine::update_route(MissionId mission, int priority, std::span<c
   }
 }
 
+std::vector<std::pair<NodeId, NodeId>> PreemptionEngine::update_flushes(MissionId mission, int priority,
+                                                                         std::span<const Crossing> crossings, double now_s,
+                                                                         std::vector<NodeId>& touched) {
+  std::vector<std::pair<NodeId, NodeId>> wanted;  // (signal flushed, crossing it clears)
+  const VicinityConfig& v = config_.vicinity;
+  if (!v.enabled) return wanted;
+  auto& entries = missions_[mission];
+  for (const Crossing& c : crossings) {
+    if (c.arrival_s - now_s > v.max_lead_s || exhausted_.count({mission, c.node}) != 0) continue;
+    // The links leaving the vehicle's stop line other than its own: a vehicle ahead of it in its
+    // lane may be bound for one of them, and stands there while that link is full.
+    for (EdgeId link : graph_.out_edges(graph_.head(c.in_edge))) {
+      if (link == c.out_edge) continue;
+      const NodeId d = signal_node(graph_.head(link));
+      const auto plan_it = plans_.find(d);
+      const auto measured = measurements_.find(d);
+      if (d == c.node || plan_it == plans_.end() || measured == measurements_.end()) continue;
+      const maps::Compass side = maps::approach_side(graph_, link);
+      const std::optional<double> queue_m = measured->second[static_cast<int>(side)].queue_m;
+      if (!queue_m || *queue_m < v.spillback_fraction * graph_.length_m(link)) continue;
+      const maps::SignalPlan& plan = plan_it->second;
+      std::optional<std::size_t> movement;
+      for (std::size_t m = 0; m < plan.movements.size() && !movement; ++m) {
+        if (plan.movements[m].from == side) movement = m;
+      }
+      if (!movement || std::find(wanted.begin(), wanted.end(), std::pair(d, c.node)) != wanted.end()) continue;
+      if (exhausted_.count({mission, d}) != 0) continue;
+      wanted.emplace_back(d, c.node);
+      ScheduleEntry* e = nullptr;
+      for (auto& x : entries) {
+        if (is_live(*x) && x->node == d && x->flush_for == c.node) e = x.get();
+      }
+      const bool fresh = e == nullptr;
+      if (fresh) {
+        entries.push_back(std::make_unique<ScheduleEntry>());
+        e = entries.back().get();
+        e->mission = mission;
+        e->node = d;
+        e->flush_for = c.node;
+        e->vicinity = "side_spillback";
+        e->congestion = CongestionLevel::high;
+        e->movement = *movement;
+        e->movement_label = plan.movements[*movement].label();
+        e->phase = select_phase(plan, *movement, controller_.current_phase(d), CongestionLevel::high).phase;
+      }
+      e->priority = priority;
+      // Its outflow moving before the vehicle reaches c: the spill-back rule, for a side link.
+      const double trans = transition_time_s(controller_.remaining_min_green_s(d, now_s), plan.yellow_s, plan.all_red_s);
+      const double clearance = queue_clearance_s(*queue_m / v.jam_spacing_m, config_.timing);
+      e->arrival_s = c.arrival_s;
+      e->natural_start_s = std::max({now_s, c.arrival_s - v.max_lead_s, c.arrival_s - trans - config_.timing.safety_margin_s - clearance});
+      if (e->state == EntryState::active) e->natural_start_s = std::min(e->natural_start_s, e->started_s);
+      e->release_s = c.arrival_s + config_.release_after_arrival_s;
+      if (fresh) {
+        nodes_[d].entries.push_back(e);
+        log(now_s, mission, d, "scheduled",
+            "phase=" + e->phase.label + " start_s=" + fmt_s(e->natural_start_s) + " arrival_s=" + fmt_s(e->arrival_s) +
+                " congestion=high vicinity=side_spillback for_node=" + std::to_string(c.node.v));
+      }
+      touched.push_back(d);
+    }
+  }
+  return wanted;
+}
+
+NodeId PreemptionEngine::signal_node(NodeId node) const {
+  const auto it = signal_of_.find(node);
+  return it == signal_of_.end() ? node : it->second;
+}
+
+void PreemptionEngine::set_signal_nodes(std::unordered_map<NodeId, NodeId> signal_of) { signal_of_ = std::move(signal_of); }
+
 void PreemptionEngine::vehicle_passed(MissionId mission, NodeId node, double now_s) {
   auto it = missions_.find(mission);
   if (it == missions_.end()) return;
+  std::vector<NodeId> touched;
   for (auto& e : it->second) {
-    if (e->node == node && is_live(*e)) {
+    // Its own hold at the node, and the side links flushed for it there.
+    if (is_live(*e) && ((e->node == node && !e->flush_for) || e->flush_for == node)) {
       finish(*e, EntryState::released, now_s, "reason=vehicle_cleared_stop_line");
-      arbitrate(node, now_s);
-      refresh_node(node, now_s);
+      touched.push_back(e->node);
     }
+  }
+  for (NodeId n : touched) {
+    arbitrate(n, now_s);
+    refresh_node(n, now_s);
   }
 }
 

@@ -30,7 +30,8 @@ using MissionId = std::uint64_t;
 // Vicinity-aware preemption (the seed's future work): queues near the route, not only the vehicle's
 // own approach, decide when a hold starts. Both rules need a measured standing queue
 // (record_queue_length); without one they change nothing, and with `enabled` false the engine is
-// the seed's route-only preemption.
+// the seed's route-only preemption. Where a rule applies, the hold serves the vehicle's whole
+// approach (the seed's high-congestion phase), so the queue moves whatever its vehicles' turns.
 struct VicinityConfig {
   bool enabled = false;
   double jam_spacing_m = 7.5;       // metres of lane per queued vehicle
@@ -83,8 +84,12 @@ struct ScheduleEntry {
   double release_s = 0;
   EntryState state = EntryState::planned;
   bool deferred = false;  // lost arbitration: served right after the winner
-  // Why a vicinity rule moved the start earlier: "approach_queue" or "spillback"; empty otherwise.
+  // Why a vicinity rule moved the start earlier: "approach_queue", "spillback", or
+  // "side_spillback" for a flush of a link off the route; empty otherwise.
   std::string vicinity;
+  // A side-link flush: the crossing on the route whose blocking it clears (released when the
+  // vehicle passes that crossing); empty for the route's own holds.
+  std::optional<NodeId> flush_for;
 };
 
 struct PreemptionEvent {
@@ -119,6 +124,9 @@ class PreemptionEngine {
   // lane-area detector's jam length reports it): the vicinity rules' input. Throws CountError for
   // a negative or non-finite length or a node without a signal.
   void record_queue_length(NodeId node, maps::Compass approach, double queue_m);
+  // Where several graph nodes are one signal (a SUMO light's stop lines), each node's signal node,
+  // the key of `plans`; nodes not listed are their own.
+  void set_signal_nodes(std::unordered_map<NodeId, NodeId> signal_of);
   // Starts holds whose time has come, expires overdue ones, and releases signals no one holds.
   void tick(double now_s);
 
@@ -143,6 +151,12 @@ class PreemptionEngine {
     double start_s;
     bool spillback;
   };
+  // Vicinity, side links: flushes of the lights whose approach is a link leaving the vehicle's stop
+  // line off its route and about to spill back into it. Schedules and re-times them; returns the
+  // (signal, crossing) pairs wanted now. Nodes it changed go to `touched`.
+  std::vector<std::pair<NodeId, NodeId>> update_flushes(MissionId mission, int priority, std::span<const Crossing> crossings,
+                                                        double now_s, std::vector<NodeId>& touched);
+  [[nodiscard]] NodeId signal_node(NodeId node) const;
   [[nodiscard]] std::optional<VicinityStart> vicinity_start(const Crossing& c, const Crossing* previous, double trans_s,
                                                             double now_s) const;
   void arbitrate(NodeId node, double now_s);
@@ -163,6 +177,7 @@ class PreemptionEngine {
   // (mission, signal) pairs whose hold hit max_hold_s: never held again for that mission, so a
   // stuck vehicle cannot keep a junction by re-scheduling.
   std::set<std::pair<MissionId, NodeId>> exhausted_;
+  std::unordered_map<NodeId, NodeId> signal_of_;
 };
 
 }  // namespace corridor::preemption

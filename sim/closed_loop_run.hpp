@@ -127,6 +127,7 @@ struct EvRun {
   double pos = 0.0;
   std::set<NodeId> preempted;
   std::size_t deferrals = 0;
+  int standing_s = 0;  // steps (seconds) at a standstill, for the diagnostics
   // Time–space record: distance driven on the edges behind, and the lights of the crossings ahead.
   double driven_m = 0.0;
   std::vector<preemption::Crossing> ahead;
@@ -196,6 +197,7 @@ ClosedLoopResult run_loop(const SumoScenario& scenario, const ClosedLoopConfig& 
   preemption::PreemptionConfig preemption_config;
   preemption_config.vicinity.enabled = config.vicinity;
   preemption::PreemptionEngine engine(g, scenario.signal_plans, controller, preemption_config);
+  engine.set_signal_nodes(scenario.signal_node);
 
   Api::Simulation::subscribe(std::vector<int>{libsumo::VAR_COLLIDING_VEHICLES_NUMBER, libsumo::VAR_TELEPORT_STARTING_VEHICLES_NUMBER});
   for (const auto& [id, arcs] : sg.arcs_onto) Api::Edge::subscribe(id, {libsumo::VAR_CURRENT_TRAVELTIME});
@@ -339,6 +341,24 @@ ClosedLoopResult run_loop(const SumoScenario& scenario, const ClosedLoopConfig& 
         std::size_t k = ev.route_index;
         while (k < ev.route.size() && sg.sumo_edge_of_arc[ev.route[k].index()] != ev.edge) ++k;
         if (k < ev.route.size()) ev.route_index = k;
+      }
+      // Why an EV stands: its lane and its leader's, every 30 s of standing (diagnostics).
+      if (const double v = as_double(state, libsumo::VAR_SPEED); std::isfinite(v) && v < 0.1) {
+        if (++ev.standing_s % 30 == 0) {
+          const auto leader = Api::Vehicle::getLeader(ev.id, 100.0);
+          std::string ahead = "none";
+          if (!leader.first.empty()) {
+            ahead = fmt::format("{} gap={:.1f} lane={} speed={:.1f} route_next={}", leader.first, leader.second,
+                                Api::Vehicle::getLaneID(leader.first), Api::Vehicle::getSpeed(leader.first),
+                                Api::Vehicle::getRoute(leader.first).size() > static_cast<std::size_t>(Api::Vehicle::getRouteIndex(leader.first)) + 1
+                                    ? Api::Vehicle::getRoute(leader.first)[static_cast<std::size_t>(Api::Vehicle::getRouteIndex(leader.first)) + 1]
+                                    : std::string("-"));
+          }
+          spdlog::info("event=ev_standing t={:.0f} ev={} lane={} pos={:.1f} standing_s={} leader={}", t, ev.id,
+                       Api::Vehicle::getLaneID(ev.id), ev.pos, ev.standing_s, ahead);
+        }
+      } else {
+        ev.standing_s = 0;
       }
       if (sample) {
         ev.track.t_s.push_back(t);

@@ -429,6 +429,15 @@ TEST(VicinityPreemption, ApproachQueueStartsClearanceBeforeTheVehicleMeetsItsTai
   const double trans = transition_time_s(with.controller.remaining_min_green_s(with.b, 0.0), with.plans.at(with.b).yellow_s,
                                          with.plans.at(with.b).all_red_s);
   EXPECT_NEAR(v.start_s, 80.0 - 15.0 - trans - 3.0 - 18.0, 1e-6);
+  // The queue moves whatever its vehicles' turns: the whole West approach is green.
+  EXPECT_EQ(v.congestion, CongestionLevel::high);
+  const maps::SignalPlan& plan = with.plans.at(with.b);
+  for (std::size_t m = 0; m < plan.movements.size(); ++m) {
+    if (plan.movements[m].from == west) {
+      EXPECT_TRUE(v.phase.serves(m)) << plan.movements[m].label();
+    }
+  }
+  EXPECT_EQ(r.congestion, CongestionLevel::low);
   EXPECT_LT(v.start_s, r.start_s);
   // A and D have no queue: untouched.
   EXPECT_DOUBLE_EQ(with.at(with.a).start_s, without.at(without.a).start_s);
@@ -468,6 +477,61 @@ TEST(VicinityPreemption, LinkAboutToSpillBackGetsItsOutflowGreenBeforeTheVehicle
     if (t == 30.0) rig.engine->vehicle_passed(1, rig.a, t);
     if (t == 80.0) rig.engine->vehicle_passed(1, rig.b, t);
     if (t == 130.0) rig.engine->vehicle_passed(1, rig.d, t);
+    rig.engine->tick(t);
+  }
+  for (NodeId n : {rig.a, rig.b, rig.d}) EXPECT_FALSE(rig.engine->holding(n));
+  EXPECT_TRUE(rig.monitor.violations().empty()) << rig.monitor.violations().front();
+}
+
+// Side link: the vehicle turns north at B, but the link B -> D, which vehicles ahead of it in its
+// lane may take, holds 150 m of queue: about to spill back into B. D's West approach (the outflow
+// of that link) is flushed before the vehicle reaches B, and released when it has passed B. A
+// shorter queue flushes nothing, and neither does route-only preemption.
+TEST(VicinityPreemption, SideLinkAboutToSpillBackIsFlushedAndReleasedWithTheCrossing) {
+  const auto north_at_b = [](const CorridorRig& rig) {
+    planner::Route r;
+    r.found = true;
+    r.start = {edge(rig.graph, 1, 2), 100.0};
+    r.edges = {edge(rig.graph, 1, 2), edge(rig.graph, 2, 3), edge(rig.graph, 3, 8)};
+    r.nodes = {rig.a, rig.b, rig.node(8)};
+    r.arrival_s = {30.0, 80.0, 110.0};
+    return signalized_crossings(rig.graph, r, rig.plans, 0.0);
+  };
+  CorridorRig rig(true), off(false), shorter(true);
+  const auto west = maps::approach_side(rig.graph, edge(rig.graph, 3, 4));
+  rig.engine->record_queue_length(rig.d, west, 150.0);
+  off.engine->record_queue_length(off.d, west, 150.0);
+  shorter.engine->record_queue_length(shorter.d, west, 60.0);
+  rig.engine->update_route(1, 1, north_at_b(rig), 0.0);
+  off.engine->update_route(1, 1, north_at_b(off), 0.0);
+  shorter.engine->update_route(1, 1, north_at_b(shorter), 0.0);
+  const ScheduleEntry flush = rig.at(rig.d);
+  ASSERT_TRUE(flush.flush_for.has_value());
+  EXPECT_EQ(*flush.flush_for, rig.b);
+  EXPECT_EQ(flush.vicinity, "side_spillback");
+  const double trans =
+      transition_time_s(rig.controller.remaining_min_green_s(rig.d, 0.0), rig.plans.at(rig.d).yellow_s, rig.plans.at(rig.d).all_red_s);
+  EXPECT_NEAR(flush.start_s, std::max(80.0 - 90.0, 80.0 - trans - 3.0 - (2.0 + 2.0 * 20.0)), 1e-6);
+  EXPECT_LE(flush.start_s, 80.0 - trans - 3.0);
+  const maps::SignalPlan& plan = rig.plans.at(rig.d);
+  for (std::size_t m = 0; m < plan.movements.size(); ++m) {
+    if (plan.movements[m].from == west) {
+      EXPECT_TRUE(flush.phase.serves(m)) << plan.movements[m].label();
+    }
+  }
+  EXPECT_FALSE(off.at(off.d).flush_for.has_value());
+  EXPECT_EQ(off.engine->schedule(1).size(), 2u);
+  EXPECT_EQ(shorter.engine->schedule(1).size(), 2u);
+
+  double t = 0.0;
+  for (; t <= 200.0; t += 0.5) {
+    rig.controller.advance(t);
+    if (t == 30.0) rig.engine->vehicle_passed(1, rig.a, t);
+    if (t == 80.0) {
+      EXPECT_TRUE(rig.engine->holding(rig.d));
+      rig.engine->vehicle_passed(1, rig.b, t);
+      EXPECT_EQ(rig.at(rig.d).state, EntryState::released);
+    }
     rig.engine->tick(t);
   }
   for (NodeId n : {rig.a, rig.b, rig.d}) EXPECT_FALSE(rig.engine->holding(n));
