@@ -242,6 +242,18 @@ void SumoSignalController::update(double now_s) {
             restore_program(l, now_s);  // released before the held green was shown
             break;
           }
+          // The target may have changed while the clearance ran: a link still green that the new
+          // target drops is cleared (yellow, all-red) before anything turns green.
+          bool drops = false;
+          for (std::size_t i = 0; i < l.shown.size() && i < l.target.size(); ++i) {
+            drops = drops || (is_green(l.shown[i]) && !is_green(l.target[i]));
+          }
+          if (drops) {
+            l.stage = Stage::clear_yellow;
+            l.stage_start_s = now_s;
+            l.wait_until_s = now_s;
+            continue;
+          }
           show(l, l.target, now_s);
           l.held_since_s = now_s;
           ++holds_reached_;

@@ -168,6 +168,24 @@ TEST(SumoSignalController, ChangingTheHeldPhaseClearsTheOldGreenFirst) {
   EXPECT_TRUE(c.violations().empty());
 }
 
+// A new held phase asked for while the clearance towards the first is running: a link the first
+// kept green and the second drops still gets its yellow and all-red before the second's green
+// (found in the Fig. 11 matrix, where a light went from green to red without yellow).
+TEST(SumoSignalController, ChangingTheTargetDuringTheClearanceStillClearsWhatItDrops) {
+  Fixture f;
+  FakeLights api(f.phases["J"]);
+  SumoSignalController c(f.plans, f.sumo_of, f.phases, api);
+  run(api, c, 0.0, 10.0);
+  c.hold(f.node, maps::Phase{"Grrr", {1, 0, 0, 0}, 5.0}, 10.0);
+  run(api, c, 10.5, 12.0);
+  c.hold(f.node, f.plans[f.node].phases[1], 12.0);
+  run(api, c, 12.5, 30.0);
+  const std::vector<std::pair<double, std::string>> expected{{10.0, "Gyrr"}, {13.0, "Grrr"}, {15.0, "yrrr"},
+                                                             {18.0, "rrrr"}, {20.0, "rrGG"}};
+  EXPECT_EQ(api.history, expected);
+  EXPECT_TRUE(c.violations().empty()) << c.violations().front();
+}
+
 TEST(SumoSignalController, RejectsAPlanWithoutItsLight) {
   Fixture f;
   FakeLights api(f.phases["J"]);
