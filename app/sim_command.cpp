@@ -167,7 +167,7 @@ void run_sim(const SimOptions& o) {
   record.ev_from = c.ev_from;
   record.ev_to = c.ev_to;
   record.ev_depart_s = c.ev_depart_s;
-  record.vicinity = c.vicinity;
+  record.vicinity = c.vicinity && o.server.empty();  // the server's engine runs route-only
   record.evs = o.evs;
   record.result = sim::run_closed_loop(*scenario, c);
   const std::string text = sim::to_json_record(record).dump(2);

@@ -14,8 +14,10 @@ namespace {
 
 bool is_live(const ScheduleEntry& e) { return e.state == EntryState::planned || e.state == EntryState::active; }
 
-// Arbitration order: mission priority (higher first), then predicted arrival, then mission id.
+// Arbitration order: a vehicle's own crossing before any side-link flush, then mission priority
+// (higher first), then predicted arrival, then mission id.
 bool serves_first(const ScheduleEntry* a, const ScheduleEntry* b) {
+  if (a->flush_for.has_value() != b->flush_for.has_value()) return !a->flush_for.has_value();
   if (a->priority != b->priority) return a->priority > b->priority;
   if (a->arrival_s != b->arrival_s) return a->arrival_s < b->arrival_s;
   return a->mission < b->mission;
@@ -205,7 +207,8 @@ void PreemptionEngine::arbitrate(NodeId node, double now_s) {
     if (e->deferred && e->state == EntryState::active && e->start_s > now_s) e->state = EntryState::planned;
     if (e->deferred && !was_deferred) {
       log(now_s, e->mission, node, "deferred",
-          "phase=" + e->phase.label + " start_s=" + fmt_s(e->start_s) + " reason=conflicting_higher_claim");
+          "phase=" + e->phase.label + " start_s=" + fmt_s(e->start_s) + " reason=conflicting_higher_claim" +
+              (e->flush_for ? " flush_for=" + std::to_string(e->flush_for->v) : ""));
     }
     accepted.push_back(e);
   }
@@ -257,7 +260,8 @@ void PreemptionEngine::refresh_node(NodeId node, double now_s) {
       e->state = EntryState::active;
       e->started_s = now_s;
       log(now_s, e->mission, node, "started",
-          "phase=" + e->phase.label + " arrival_s=" + fmt_s(e->arrival_s) + " movement=" + e->movement_label);
+          "phase=" + e->phase.label + " arrival_s=" + fmt_s(e->arrival_s) + " movement=" + e->movement_label +
+              (e->flush_for ? " flush_for=" + std::to_string(e->flush_for->v) : ""));
     }
     for (std::size_t m = 0; m < want.size(); ++m) want[m] = want[m] || e->phase.serves(m);
     if (label.find(e->phase.label) == std::string::npos) label += (label.empty() ? "" : "|") + e->phase.label;
@@ -327,8 +331,11 @@ void PreemptionEngine::update_route(MissionId mission, int priority, std::span<c
   for (auto& e : entries) {
     if (!is_live(*e)) continue;
     if (e->flush_for) {
-      if (std::find(flushes.begin(), flushes.end(), std::pair(e->node, *e->flush_for)) == flushes.end()) {
-        finish(*e, EntryState::cancelled, now_s, "reason=side_link_no_longer_spilling");
+      // A flush already on keeps going until the vehicle passes (or the bounds end it): its own
+      // outflow draining the queue is no reason to hand the light back and take it again.
+      const bool wanted = std::find(flushes.begin(), flushes.end(), std::pair(e->node, *e->flush_for)) != flushes.end();
+      if (!wanted && e->state == EntryState::planned) {
+        finish(*e, EntryState::cancelled, now_s, "reason=side_flush_no_longer_wanted");
         touched.push_back(e->node);
       }
     } else if (std::find(on_route.begin(), on_route.end(), e->node) == on_route.end()) {
@@ -483,7 +490,8 @@ void PreemptionEngine::tick(double now_s) {
       if (now_s > e->arrival_s + config_.max_overrun_s) {
         finish(*e, EntryState::expired, now_s, "reason=vehicle_overdue");
       } else if (e->state == EntryState::active && now_s > e->started_s + config_.max_hold_s) {
-        exhausted_.insert({e->mission, e->node});
+        // A flush that ran out does not bar the vehicle's own later hold at that light.
+        if (!e->flush_for) exhausted_.insert({e->mission, e->node});
         finish(*e, EntryState::expired, now_s, "reason=max_hold");
       } else if (e->state == EntryState::active && now_s > e->release_s + config_.release_grace_s) {
         // Re-timed on every replan, release_s runs ahead of a vehicle that reports; one that went

@@ -97,7 +97,7 @@ struct PreemptionEvent {
   MissionId mission;
   NodeId node;
   std::string kind;  // scheduled, retimed, started, released, cancelled, expired, deferred
-  std::string detail;
+  std::string detail;  // key=value pairs; a side-link flush's carry flush_for=<node>
 };
 
 class PreemptionEngine {

@@ -304,6 +304,7 @@ std::vector<EvTrip> conflicting_ev_trips(const SumoScenario& scenario, const EvT
   const auto goals = detail::points_on(sg, first.to, std::nullopt);
   if (starts.empty() || goals.empty()) throw SimError("the first EV's edges '" + first.from + "', '" + first.to + "' are not drivable");
   const planner::Route main = search.run(planner::SearchSpace(cost, starts, goals), true);
+  if (!main.found) throw SimError("the first EV's goal '" + first.to + "' cannot be reached from '" + first.from + "'");
   // The first EV's lights, with its approach edge and predicted arrival there.
   struct Light {
     std::string tls;
@@ -311,7 +312,8 @@ std::vector<EvTrip> conflicting_ev_trips(const SumoScenario& scenario, const EvT
     double arrival_s;
   };
   std::vector<Light> lights;
-  for (std::size_t i = 0; i < main.nodes.size(); ++i) {
+  // The lights it crosses: not the goal edge's own stop line, which it never reaches.
+  for (std::size_t i = 0; i < main.nodes.size() && i + 1 < main.edges.size(); ++i) {
     const auto it = scenario.sumo_plan_of.find(main.nodes[i]);
     if (it != scenario.sumo_plan_of.end()) lights.push_back({it->second->tls_id, sg.sumo_edge_of_node[main.nodes[i].index()], first.depart_s + main.arrival_s[i]});
   }

@@ -135,7 +135,10 @@ ScenarioNet build_nema_grid_net(const std::filesystem::path& dir, const GridSpec
   }
   tll += "</tlLogics>\n";
   const auto tll_file = dir / (name + ".tll.xml");
-  std::ofstream(tll_file, std::ios::trunc) << tll;
+  std::ofstream tll_out(tll_file, std::ios::trunc);
+  tll_out << tll;
+  tll_out.close();
+  if (!tll_out) throw SimError("cannot write " + tll_file.string());
   run_tool({"netconvert", "--sumo-net-file", base.net.string(), "--tllogic-files", tll_file.string(), "-o", net.net.string()},
            dir / "netconvert_nema.log");
   return net;

@@ -287,7 +287,7 @@ std::size_t emit_sumo_jobs(const SumoExperimentOptions& o, const std::filesystem
                                   "--end-s", fmt::format("{:g}", c.end_s - plan.begin_s),
                                   "--congestion-period-s", fmt::format("{:g}", c.congestion_period_s),
                                   "--incidents", std::to_string(c.incidents),
-                                  "--evs", std::to_string(run.record.evs),
+                                  "--evs", std::to_string(c.with_ev ? run.record.evs : 1u),
                                   "--result", run.result_file.string()};
     if (!c.vicinity) args.emplace_back("--route-only");
     if (plan.net.config) {

@@ -167,6 +167,9 @@ void SumoSignalController::hold(NodeId node, const maps::Phase& phase, double no
     update(now_s);
     return;
   }
+  // All-red still running before the held green was shown: only the target changes; the held
+  // stage clears whatever the new target drops once the all-red has run.
+  if (l.stage == Stage::held && l.held_since_s < 0.0) return;
   if (l.stage == Stage::held || l.stage == Stage::back_yellow || l.stage == Stage::back_all_red) {
     // Change of held phase: clear whatever is green and not in the new phase.
     l.wait_until_s = l.stage == Stage::held ? l.held_since_s + l.held_phase.min_green_s : now_s;

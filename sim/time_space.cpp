@@ -63,8 +63,8 @@ std::string render_time_space_svg(const std::vector<TimeSpaceTrack>& tracks, con
     s += fmt::format("<line x1=\"{0:.1f}\" y1=\"{2:.1f}\" x2=\"{1:.1f}\" y2=\"{2:.1f}\" stroke=\"#ddd\"/>\n", kLeft, kWidth - kRight, py(d));
     s += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"end\">{:.0f}</text>\n", kLeft - 6, py(d) + 4, d);
   }
-  // Signals: a bar per light interval at the stop line's distance, the first EV's signals only when
-  // several EVs drove different paths (their distances are along different paths).
+  // Signals: a bar per light interval at the stop line's distance, for the first EV's path only
+  // (other EVs' distances run along other paths; their lights are in the CSV).
   for (std::size_t k = 0; k < tracks.size() && k < 1; ++k) {
     for (const auto& sig : tracks[k].signals) {
       for (std::size_t i = 0; i + 1 < sig.states.size(); ++i) {

@@ -526,6 +526,12 @@ TEST(VicinityPreemption, SideLinkAboutToSpillBackIsFlushedAndReleasedWithTheCros
   double t = 0.0;
   for (; t <= 200.0; t += 0.5) {
     rig.controller.advance(t);
+    if (t == 40.0) {
+      // The flush (on since about 25 s) drained the queue: it still runs until the vehicle passes B.
+      rig.engine->record_queue_length(rig.d, west, 0.0);
+      rig.engine->update_route(1, 1, north_at_b(rig), t);
+      EXPECT_EQ(rig.at(rig.d).state, EntryState::active);
+    }
     if (t == 30.0) rig.engine->vehicle_passed(1, rig.a, t);
     if (t == 80.0) {
       EXPECT_TRUE(rig.engine->holding(rig.d));

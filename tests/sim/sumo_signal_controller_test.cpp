@@ -186,6 +186,22 @@ TEST(SumoSignalController, ChangingTheTargetDuringTheClearanceStillClearsWhatItD
   EXPECT_TRUE(c.violations().empty()) << c.violations().front();
 }
 
+// A new held phase asked for during the all-red before the held green: the all-red still runs in
+// full before anything turns green.
+TEST(SumoSignalController, ChangingTheTargetDuringTheAllRedKeepsTheAllRed) {
+  Fixture f;
+  FakeLights api(f.phases["J"]);
+  SumoSignalController c(f.plans, f.sumo_of, f.phases, api);
+  run(api, c, 0.0, 10.0);
+  c.hold(f.node, f.plans[f.node].phases[1], 10.0);  // GGrr -> yyrr (10) -> rrrr (13) -> rrGG (15)
+  run(api, c, 10.5, 13.5);
+  c.hold(f.node, maps::Phase{"rrGr", {0, 0, 1, 0}, 5.0}, 13.5);
+  run(api, c, 14.0, 20.0);
+  const std::vector<std::pair<double, std::string>> expected{{10.0, "yyrr"}, {13.0, "rrrr"}, {15.0, "rrGr"}};
+  EXPECT_EQ(api.history, expected);
+  EXPECT_TRUE(c.violations().empty()) << c.violations().front();
+}
+
 TEST(SumoSignalController, RejectsAPlanWithoutItsLight) {
   Fixture f;
   FakeLights api(f.phases["J"]);
