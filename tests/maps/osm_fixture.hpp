@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include <unistd.h>
+#include "tests/temp_dir.hpp"
 
 namespace corridor::maps::testing {
 
@@ -59,29 +59,7 @@ inline void write_osm(const std::filesystem::path& file, const std::vector<Fixtu
   out << "</osm>\n";
 }
 
-// A fresh temporary directory per test, removed afterwards.
-class TempDir {
- public:
-  TempDir() {
-    path_ = std::filesystem::temp_directory_path() /
-            ("corridor-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter()++));
-    std::filesystem::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    std::filesystem::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  [[nodiscard]] const std::filesystem::path& path() const { return path_; }
-
- private:
-  static int& counter() {
-    static int c = 0;
-    return c;
-  }
-  std::filesystem::path path_;
-};
+using corridor::testing::TempDir;
 
 inline std::filesystem::path shared_osm(const std::string& name) {
   return std::filesystem::path(CORRIDOR_SHARED_DATA_DIR) / "osm" / name;

@@ -8,7 +8,7 @@
 
 #include "sim/errors.hpp"
 #include "sim/sumo_experiment.hpp"
-#include "tests/sim/temp_dir.hpp"
+#include "tests/temp_dir.hpp"
 
 namespace corridor::sim {
 namespace {

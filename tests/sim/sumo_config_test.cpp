@@ -9,7 +9,7 @@
 
 #include "maps/sumo_net.hpp"
 #include "sim/errors.hpp"
-#include "tests/sim/temp_dir.hpp"
+#include "tests/temp_dir.hpp"
 
 namespace corridor::sim {
 namespace {

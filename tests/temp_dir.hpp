@@ -1,20 +1,19 @@
-// A fresh directory in the temp directory, unique per process and test, removed with its contents.
+// A fresh directory in the temp directory, unique per process and per instance, removed with its
+// contents: the one temporary directory of every test suite.
 #pragma once
 
-#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <filesystem>
 #include <string>
 
-namespace corridor::sim::testing {
+namespace corridor::testing {
 
 class TempDir {
  public:
-  explicit TempDir(const std::string& prefix)
+  explicit TempDir(const std::string& prefix = "corridor-test")
       : path_(std::filesystem::temp_directory_path() /
-              (prefix + "-" + std::to_string(::getpid()) + "-" +
-               ::testing::UnitTest::GetInstance()->current_test_info()->name())) {
+              (prefix + "-" + std::to_string(::getpid()) + "-" + std::to_string(counter()++))) {
     std::filesystem::remove_all(path_);  // a killed run with the same pid may have left it behind
     std::filesystem::create_directories(path_);
   }
@@ -27,7 +26,11 @@ class TempDir {
   [[nodiscard]] const std::filesystem::path& path() const { return path_; }
 
  private:
+  static int& counter() {
+    static int c = 0;
+    return c;
+  }
   std::filesystem::path path_;
 };
 
-}  // namespace corridor::sim::testing
+}  // namespace corridor::testing
