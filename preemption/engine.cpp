@@ -69,9 +69,9 @@ PreemptionEngine::PreemptionEngine(const maps::RoadGraph& graph, const std::unor
                                    SignalController& controller, PreemptionConfig config)
     : graph_(graph), plans_(plans), controller_(controller), config_(config) {}
 
-void PreemptionEngine::log(double t, MissionId m, NodeId n, std::string kind, std::string detail) {
+void PreemptionEngine::log(double t, MissionId m, NodeId n, std::string kind, std::string detail, bool side_flush) {
   spdlog::info("event=preemption_{} t={:.1f} mission={} node={} {}", kind, t, m, n.v, detail);
-  events_.push_back({t, m, n, std::move(kind), std::move(detail)});
+  events_.push_back({t, m, n, std::move(kind), std::move(detail), side_flush});
 }
 
 std::optional<PreemptionEngine::VicinityStart> PreemptionEngine::vicinity_start(const Crossing& c, const Crossing* previous,
@@ -208,7 +208,8 @@ void PreemptionEngine::arbitrate(NodeId node, double now_s) {
     if (e->deferred && !was_deferred) {
       log(now_s, e->mission, node, "deferred",
           "phase=" + e->phase.label + " start_s=" + fmt_s(e->start_s) + " reason=conflicting_higher_claim" +
-              (e->flush_for ? " flush_for=" + std::to_string(e->flush_for->v) : ""));
+              (e->flush_for ? " flush_for=" + std::to_string(e->flush_for->v) : ""),
+          e->flush_for.has_value());
     }
     accepted.push_back(e);
   }
@@ -261,7 +262,8 @@ void PreemptionEngine::refresh_node(NodeId node, double now_s) {
       e->started_s = now_s;
       log(now_s, e->mission, node, "started",
           "phase=" + e->phase.label + " arrival_s=" + fmt_s(e->arrival_s) + " movement=" + e->movement_label +
-              (e->flush_for ? " flush_for=" + std::to_string(e->flush_for->v) : ""));
+              (e->flush_for ? " flush_for=" + std::to_string(e->flush_for->v) : ""),
+          e->flush_for.has_value());
     }
     for (std::size_t m = 0; m < want.size(); ++m) want[m] = want[m] || e->phase.serves(m);
     if (label.find(e->phase.label) == std::string::npos) label += (label.empty() ? "" : "|") + e->phase.label;
@@ -288,7 +290,7 @@ void PreemptionEngine::finish(ScheduleEntry& e, EntryState state, double now_s, 
   e.state = state;
   auto& list = nodes_[e.node].entries;
   list.erase(std::remove(list.begin(), list.end(), &e), list.end());
-  log(now_s, e.mission, e.node, to_string(state), detail);
+  log(now_s, e.mission, e.node, to_string(state), detail, e.flush_for.has_value());
 }
 
 void PreemptionEngine::update_route(MissionId mission, int priority, std::span<const Crossing> crossings, double now_s) {
@@ -406,7 +408,8 @@ std::vector<std::pair<NodeId, NodeId>> PreemptionEngine::update_flushes(MissionI
         nodes_[d].entries.push_back(e);
         log(now_s, mission, d, "scheduled",
             "phase=" + e->phase.label + " start_s=" + fmt_s(e->natural_start_s) + " arrival_s=" + fmt_s(e->arrival_s) +
-                " congestion=high vicinity=side_spillback for_node=" + std::to_string(c.node.v));
+                " congestion=high vicinity=side_spillback for_node=" + std::to_string(c.node.v),
+            true);
       }
       touched.push_back(d);
     }

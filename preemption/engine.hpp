@@ -97,7 +97,8 @@ struct PreemptionEvent {
   MissionId mission;
   NodeId node;
   std::string kind;  // scheduled, retimed, started, released, cancelled, expired, deferred
-  std::string detail;  // key=value pairs; a side-link flush's carry flush_for=<node>
+  std::string detail;  // key=value pairs
+  bool side_flush = false;  // about a side-link flush, not one of the vehicle's own crossings
 };
 
 class PreemptionEngine {
@@ -163,7 +164,7 @@ class PreemptionEngine {
   void finish(ScheduleEntry& e, EntryState state, double now_s, const std::string& detail);
   void refresh_node(NodeId node, double now_s);
   [[nodiscard]] std::size_t recovery_step(NodeId node, const NodeState& ns, double now_s) const;
-  void log(double t, MissionId m, NodeId n, std::string kind, std::string detail);
+  void log(double t, MissionId m, NodeId n, std::string kind, std::string detail, bool side_flush = false);
 
   const maps::RoadGraph& graph_;
   const std::unordered_map<NodeId, maps::SignalPlan>& plans_;

@@ -411,7 +411,7 @@ ClosedLoopResult run_loop(const SumoScenario& scenario, const ClosedLoopConfig& 
       for (const auto& event : engine.take_events()) {
         // Side-link flushes are not the EV's own lights: they count in neither its lights nor its
         // deferrals.
-        if (event.detail.find("flush_for=") != std::string::npos) continue;
+        if (event.side_flush) continue;
         const auto it = std::find_if(evs.begin(), evs.end(), [&](const EvRun& ev) { return ev.mission == event.mission; });
         if (event.kind == "started") {
           ++result.preemptions_started;

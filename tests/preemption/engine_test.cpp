@@ -520,6 +520,10 @@ TEST(VicinityPreemption, SideLinkAboutToSpillBackIsFlushedAndReleasedWithTheCros
     }
   }
   EXPECT_FALSE(off.at(off.d).flush_for.has_value());
+  // Its events say they are about a flush, so that a caller can keep them apart from the route's.
+  const auto events = rig.engine->take_events();
+  EXPECT_TRUE(std::any_of(events.begin(), events.end(), [&](const PreemptionEvent& ev) { return ev.node == rig.d && ev.side_flush; }));
+  EXPECT_TRUE(std::none_of(events.begin(), events.end(), [&](const PreemptionEvent& ev) { return ev.node == rig.b && ev.side_flush; }));
   EXPECT_EQ(off.engine->schedule(1).size(), 2u);
   EXPECT_EQ(shorter.engine->schedule(1).size(), 2u);
 
