@@ -141,6 +141,11 @@ RoadGraph build_road_graph(const GraphBuildInput& in, GraphBuildReport* report) 
     d.edge_class.push_back(seg.road_class);
     d.edge_name.push_back(seg.name);
     d.edge_ref.push_back(seg.ref);
+    if (seg.roundabout) d.roundabout_edges.push_back(EdgeId{static_cast<std::uint32_t>(d.edge_head.size() - 1)});
+    if (seg.max_height_m > 0 || seg.max_width_m > 0 || seg.max_weight_t > 0) {
+      d.edge_limits.push_back({EdgeId{static_cast<std::uint32_t>(d.edge_head.size() - 1)}, seg.max_height_m,
+                               seg.max_width_m, seg.max_weight_t});
+    }
     d.edge_twin.push_back(e.twin != kNone && new_edge[e.twin] != kNone ? EdgeId{new_edge[e.twin]} : kInvalidEdge);
     if (e.reversed) {
       for (std::uint32_t p = seg.last_point + 1; p-- > seg.first_point;) d.geometry.push_back(in.points[p]);

@@ -23,6 +23,10 @@ struct RoadSegment {
   RoadClass road_class = RoadClass::residential;
   std::uint32_t name = 0;  // ids into GraphBuildInput::strings (0: none)
   std::uint32_t ref = 0;
+  float max_height_m = 0;  // 0: no limit
+  float max_width_m = 0;
+  float max_weight_t = 0;
+  bool roundabout = false;
 };
 
 struct GraphBuildInput {

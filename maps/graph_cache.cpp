@@ -114,6 +114,15 @@ void visit_arrays(Visitor&& v, auto& d) {
   v(d.landmarks.nodes);
   v(d.landmarks.from_ticks);
   v(d.landmarks.to_ticks);
+  v(d.edge_limits);
+  v(d.roundabout_edges);
+  v(d.restrictions.first);
+  v(d.restrictions.edges);
+  v(d.restrictions.only);
+  v(d.restrictions.mode);
+  v(d.restrictions.except_emergency);
+  v(d.turns_in_edges);
+  v(d.left_hand_traffic);
 }
 
 }  // namespace

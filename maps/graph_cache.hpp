@@ -12,7 +12,7 @@ namespace corridor::maps {
 
 // Bumped whenever the importer reads OSM differently, too: a cache stays valid only for the rules
 // that built it.
-inline constexpr std::uint32_t kGraphCacheVersion = 4;  // 2: names and refs; 3: ALT landmarks; 4: barriers, access
+inline constexpr std::uint32_t kGraphCacheVersion = 5;  // 2: names and refs; 3: ALT landmarks; 4: barriers, access; 5: turns
 
 struct CacheSource {
   std::uint64_t size_bytes = 0;

@@ -69,6 +69,8 @@ RoadGraph load_map(const std::filesystem::path& file, const MapLoadOptions& opti
   std::filesystem::path cache;
   if (!options.cache_dir.empty()) {
     cache = cache_file_for(file, options.cache_dir);
+    // The side of the road is part of the graph: one cache per side.
+    if (options.import.left_hand_traffic) cache.replace_extension(".lht.cgr");
     if (std::filesystem::is_regular_file(cache, ec)) {
       try {
         CacheSource cached_source;

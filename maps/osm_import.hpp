@@ -13,6 +13,9 @@ struct OsmImportOptions {
   // A highway=traffic_signals node on a way (not at its junction) marks the nearest junction along
   // that way as signalized, if it lies within this distance.
   double signal_to_junction_max_m = 40.0;
+  // Traffic keeps left (UK, Ireland, Japan, India, Australia...): a right turn crosses oncoming
+  // traffic. OSM extracts rarely carry the country's driving_side, so the user says it.
+  bool left_hand_traffic = false;
   bool show_progress = true;
 };
 
@@ -21,6 +24,8 @@ struct OsmImportReport {
   std::size_t osm_ways_kept = 0;
   std::size_t osm_signal_nodes = 0;
   std::size_t osm_barrier_nodes = 0;  // nodes an emergency vehicle cannot pass (split into dead ends)
+  std::size_t osm_restrictions_applied = 0;     // restriction keys resolved onto graph edges
+  std::size_t osm_restrictions_unresolved = 0;  // malformed, or members outside the graph
   GraphBuildReport graph;
 };
 

@@ -114,6 +114,8 @@ OnewayRule parse_oneway(std::string_view v) {
 
 // A length in metres: "3.5", "3.5 m", "12'6\"" (feet and inches). nullopt for "default", "none",
 // "below_default" and anything else that carries no number.
+}  // namespace
+
 std::optional<double> parse_length_m(std::string_view raw) {
   const std::string v = lower(trim(raw));
   if (v.empty()) return std::nullopt;
@@ -132,6 +134,8 @@ std::optional<double> parse_length_m(std::string_view raw) {
   if (unit == "ft") return m * 0.3048;
   return std::nullopt;
 }
+
+namespace {
 
 bool access_item_forbids(std::string_view v) {
   return is_one_of(v, {"no", "agricultural", "forestry", "emergency_no", "use_sidepath", "discouraged", "foot",
@@ -164,7 +168,21 @@ bool most_specific_forbids(std::initializer_list<std::string_view> most_specific
 
 }  // namespace
 
-bool node_blocks_emergency(const NodeTags& t, double vehicle_height_m) {
+std::optional<double> parse_weight_t(std::string_view raw) {
+  const std::string v = lower(trim(raw));
+  if (v.empty()) return std::nullopt;
+  char* end = nullptr;
+  const double w = std::strtod(v.c_str(), &end);
+  if (end == v.c_str() || !std::isfinite(w) || w <= 0) return std::nullopt;
+  const std::string unit = lower(trim(std::string_view(end)));
+  if (unit.empty() || unit == "t") return w;
+  if (unit == "kg") return w / 1000.0;
+  if (unit == "st") return w * 0.90718474;
+  if (unit == "lbs" || unit == "lb") return w * 0.45359237e-3;
+  return std::nullopt;
+}
+
+bool node_blocks_emergency(const NodeTags& t) {
   if (is_one_of(t.emergency, {"yes", "designated", "official", "permissive"})) return false;
   if (t.emergency == "no") return true;
   if (most_specific_forbids({t.motorcar, t.motor_vehicle, t.vehicle, t.access})) return true;
@@ -172,8 +190,7 @@ bool node_blocks_emergency(const NodeTags& t, double vehicle_height_m) {
   if (t.barrier == "bollard") return !is_one_of(t.bollard, {"rising", "removable", "retractable", "foldable", "flexible"});
   if (t.barrier == "kerb") return !is_one_of(t.kerb, {"lowered", "flush", "no"});
   if (t.barrier == "height_restrictor") {
-    const auto limit = parse_length_m(t.maxheight);
-    return limit.has_value() && *limit < vehicle_height_m;
+    return false;
   }
   // As OSRM's car profile: these let a car through; every other barrier stops it.
   return !is_one_of(t.barrier, {"no", "gate", "lift_gate", "swing_gate", "sliding_gate", "toll_booth",
@@ -267,6 +284,10 @@ std::optional<WayRules> interpret_way(const WayTags& t) {
   const double fallback = parse_maxspeed_kmh(t.maxspeed).value_or(default_speed_kmh(rules.road_class));
   rules.forward_speed_kmh = parse_maxspeed_kmh(t.maxspeed_forward).value_or(fallback);
   rules.backward_speed_kmh = parse_maxspeed_kmh(t.maxspeed_backward).value_or(fallback);
+  rules.max_height_m = parse_length_m(t.maxheight).value_or(0.0);
+  rules.max_width_m = parse_length_m(t.maxwidth).value_or(0.0);
+  rules.max_weight_t = parse_weight_t(t.maxweight).value_or(0.0);
+  rules.roundabout = t.junction == "roundabout" || t.junction == "circular";
   return rules;
 }
 

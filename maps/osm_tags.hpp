@@ -34,6 +34,8 @@ struct WayTags {
   std::string_view motor_vehicle_forward, motor_vehicle_backward;
   std::string_view vehicle_forward, vehicle_backward;
   std::string_view access_forward, access_backward;
+  // Physical limits.
+  std::string_view maxheight, maxwidth, maxweight;
 };
 
 // The tags of a node that may stop a vehicle on the way through it.
@@ -55,6 +57,12 @@ struct WayRules {
   bool backward = true;  // drivable against it
   double forward_speed_kmh = 0.0;
   double backward_speed_kmh = 0.0;
+  // Physical limits from maxheight, maxwidth and maxweight; 0 where the way has none. Which vehicle
+  // they stop is the vehicle profile's business, not the map's.
+  double max_height_m = 0.0;
+  double max_width_m = 0.0;
+  double max_weight_t = 0.0;
+  bool roundabout = false;  // junction=roundabout|circular
 };
 
 // Rules for an emergency vehicle, or nullopt when it may not use the way at all.
@@ -74,17 +82,23 @@ struct WayRules {
 //    closes one direction.
 std::optional<WayRules> interpret_way(const WayTags& tags);
 
+// A length in metres: "3.5", "3.5 m", "12 ft", "11'6\"". nullopt for "default", "none",
+// "below_default" and anything unparsable (no limit is assumed then).
+std::optional<double> parse_length_m(std::string_view value);
+// A weight in tonnes: "7.5", "7.5 t", "7500 kg", "10 st" (short tons), "20000 lbs".
+std::optional<double> parse_weight_t(std::string_view value);
+
 // True when an emergency vehicle cannot pass through a node, as OSRM's car profile reads barriers:
 // gate, lift_gate, swing_gate, sliding_gate, toll_booth, border_control, cattle_grid, entrance,
 // sally_port, arch and bump_gate let it through, and every other barrier stops it. Exceptions:
 //  - retractable bollards (bollard=rising|removable|retractable|foldable|flexible), which emergency
 //    services lower;
 //  - a kerb tagged kerb=lowered|flush|no;
-//  - a height_restrictor whose maxheight is at least the vehicle's height (or not given).
+//  - a height_restrictor: the importer turns its maxheight into a limit on the roads through it,
+//    which the vehicle profile checks (here it stops nothing).
 // access=no (or vehicle/motor_vehicle/motorcar=no, as on ways) on a node blocks too, and
 // emergency=yes|designated on the node lets the vehicle through any of these.
-inline constexpr double kDefaultVehicleHeightM = 3.0;  // an ambulance's box body, with roof lights
-bool node_blocks_emergency(const NodeTags& tags, double vehicle_height_m = kDefaultVehicleHeightM);
+bool node_blocks_emergency(const NodeTags& tags);
 
 // A maxspeed value in km/h: plain numbers, "mph" and "knots" units, "none", "walk", and the implicit
 // country values ("DE:urban", "FR:rural", "CH:motorway", "GB:nsl_single", "DE:zone30", ...).

@@ -49,6 +49,33 @@ void validate(const RoadGraphData& d) {
               "edge head disagrees with the reverse CSR");
     }
   }
+  for (std::size_t i = 0; i < d.edge_limits.size(); ++i) {
+    const EdgeLimit& l = d.edge_limits[i];
+    require(l.edge.index() < m && (i == 0 || d.edge_limits[i - 1].edge < l.edge), "edge limits unsorted or out of range");
+    require(std::isfinite(l.max_height_m) && std::isfinite(l.max_width_m) && std::isfinite(l.max_weight_t) &&
+                l.max_height_m >= 0 && l.max_width_m >= 0 && l.max_weight_t >= 0,
+            "edge limit is not a finite non-negative number");
+  }
+  for (std::size_t i = 0; i < d.roundabout_edges.size(); ++i) {
+    require(d.roundabout_edges[i].index() < m && (i == 0 || d.roundabout_edges[i - 1] < d.roundabout_edges[i]),
+            "roundabout edges unsorted or out of range");
+  }
+  const TurnRestrictions& r = d.restrictions;
+  require(r.first.size() == r.size() + 1 && r.mode.size() == r.size() && r.except_emergency.size() == r.size() &&
+              r.first.front() == 0 && r.first.back() == r.edges.size(),
+          "turn restriction arrays differ in length");
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    require(r.first[i] + 2 <= r.first[i + 1], "a turn restriction needs a from and a to edge");
+    require(r.mode[i] <= static_cast<std::uint8_t>(RestrictionMode::hgv), "unknown turn restriction mode");
+  }
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    for (auto j = r.first[i]; j < r.first[i + 1]; ++j) {
+      require(r.edges[j].index() < m, "turn restriction edge out of range");
+      require(j == r.first[i] || d.edge_tail[r.edges[j].index()] == d.edge_head[r.edges[j - 1].index()],
+              "turn restriction edges do not follow each other");
+    }
+  }
+  require(d.turns_in_edges.size() <= 1 && d.left_hand_traffic.size() <= 1, "traffic rule flags have the wrong size");
   const std::size_t k = d.landmarks.nodes.size();
   require(k <= 256 && d.landmarks.from_ticks.size() == n * k && d.landmarks.to_ticks.size() == n * k,
           "landmark tables have the wrong size");
@@ -80,6 +107,7 @@ RoadGraph::RoadGraph(RoadGraphData data) : data_(std::move(data)), projection_(d
   if (data_.strings.first.empty()) data_.strings.first = {0, 0};
   validate(data_);
   if (data_.landmarks.nodes.empty()) data_.landmarks = compute_landmarks(data_);
+  turns_ = TurnGraph(data_);
 
   if (node_count() > 0) {
     min_corner_ = max_corner_ = position(NodeId{0});

@@ -2,6 +2,7 @@
 // and geometry in the map's local metric frame.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -12,8 +13,18 @@
 #include "maps/landmarks.hpp"
 #include "maps/road_class.hpp"
 #include "maps/string_table.hpp"
+#include "maps/turn_graph.hpp"
+#include "maps/turn_restriction.hpp"
 
 namespace corridor::maps {
+
+// What a road allows through: 0 where no limit is tagged.
+struct EdgeLimit {
+  EdgeId edge;
+  float max_height_m = 0;
+  float max_width_m = 0;
+  float max_weight_t = 0;
+};
 
 // Plain arrays, as built by the importer and as stored in the cache. RoadGraph validates them once.
 struct RoadGraphData {
@@ -50,6 +61,21 @@ struct RoadGraphData {
 
   // ALT landmark tables (maps/landmarks.hpp). Left empty by builders; RoadGraph computes them.
   LandmarkTables landmarks;
+
+  // Physical limits (maxheight, maxwidth, maxweight, height restrictors on the road), sorted by
+  // edge; only the few edges that have one. A vehicle profile decides which bind.
+  std::vector<EdgeLimit> edge_limits;
+  // Edges on a roundabout (junction=roundabout|circular), sorted; for "take exit N" steps.
+  std::vector<EdgeId> roundabout_edges;
+
+  // Turn restrictions on the edges (maps/turn_restriction.hpp); empty where the source has none.
+  TurnRestrictions restrictions;
+  // {1} when the edges already encode the allowed turns (a SUMO net's connections, or an abstract
+  // graph of links such as the seed's hand-made ones): every turn in the graph is then legal and
+  // free. Empty or {0} for a road network with turns at its nodes.
+  std::vector<std::uint8_t> turns_in_edges;
+  // {1} where traffic keeps left (a right turn then crosses oncoming traffic). Empty or {0}: right.
+  std::vector<std::uint8_t> left_hand_traffic;
 };
 
 class RoadGraph {
@@ -93,6 +119,8 @@ class RoadGraph {
 
   [[nodiscard]] const LocalProjection& projection() const { return projection_; }
   [[nodiscard]] const RoadGraphData& data() const { return data_; }
+  // The arrays back, to build a changed graph from them (the importer adds restrictions this way).
+  [[nodiscard]] RoadGraphData take_data() && { return std::move(data_); }
 
   // ALT: a lower bound in seconds on the free-flow travel time from a to b, exactly consistent
   // (maps/landmarks.hpp). Every travel cost the planner charges is at least free flow.
@@ -108,6 +136,17 @@ class RoadGraph {
            kLandmarkTickS;
   }
 
+  [[nodiscard]] std::span<const EdgeLimit> edge_limits() const { return data_.edge_limits; }
+  [[nodiscard]] bool on_roundabout(EdgeId e) const {
+    return std::binary_search(data_.roundabout_edges.begin(), data_.roundabout_edges.end(), e);
+  }
+
+  // The edge-based graph searches run on: turns, their angles and the restrictions on them.
+  [[nodiscard]] const TurnGraph& turns() const { return turns_; }
+  [[nodiscard]] bool left_hand_traffic() const {
+    return !data_.left_hand_traffic.empty() && data_.left_hand_traffic.front() != 0;
+  }
+
   // Bounding box in the local frame.
   [[nodiscard]] Point2 min_corner() const { return min_corner_; }
   [[nodiscard]] Point2 max_corner() const { return max_corner_; }
@@ -115,6 +154,7 @@ class RoadGraph {
  private:
   RoadGraphData data_;
   LocalProjection projection_;
+  TurnGraph turns_;
   Point2 min_corner_;
   Point2 max_corner_;
 };

@@ -104,6 +104,7 @@ SumoGraph build_sumo_graph(const SumoNet& net) {
     if (it != by_ends.end()) d.edge_twin[i] = it->second;
   }
   build_reverse_adjacency(d);
+  d.turns_in_edges = {1};  // a graph edge is a SUMO connection: every turn in the graph is one SUMO allows
   return SumoGraph{RoadGraph(std::move(d)), std::move(sumo_edge_of_arc), std::move(node_edge), std::move(arcs_onto),
                    std::move(stop_line)};
 }

@@ -50,19 +50,20 @@ void DStarLite::move_start(std::vector<EdgePoint> starts) {
 }
 
 void DStarLite::edges_changed(std::span<const EdgeId> edges) {
-  const auto& graph = space_.cost().graph();
   bool start_affected = false;
   for (EdgeId e : edges) {
-    // Every arc whose cost can depend on e starts at e's tail (graph arc and goal arc) or at S.
-    recompute_rhs(SearchSpace::vertex(graph.tail(e)));
+    // Every arc whose cost can depend on e drives onto e (a turn onto e or one of its copies, or a
+    // goal arc on e), and so starts at a vertex turning onto e; or it leaves S.
+    space_.for_each_vertex_turning_onto(e, [&](Vertex u) { recompute_rhs(u); });
     start_affected = start_affected || space_.is_start_edge(e);
   }
   if (start_affected) recompute_rhs(space_.start());
 }
 
 void DStarLite::nodes_changed(std::span<const NodeId> nodes) {
-  // A node's crossing delay is part of every arc out of it, and of no other arc.
-  for (NodeId n : nodes) recompute_rhs(SearchSpace::vertex(n));
+  // A node's crossing delay is part of every arc that turns at it: the arcs out of the vertices
+  // standing there, and of no other arc.
+  for (NodeId n : nodes) space_.for_each_vertex_at(n, [&](Vertex u) { recompute_rhs(u); });
 }
 
 ReplanStats DStarLite::replan() {

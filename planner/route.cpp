@@ -24,15 +24,19 @@ Route make_route(const TravelCost& cost, EdgePoint start, std::vector<EdgeId> ed
   } else {
     double t = cost.partial_time_s(start.edge, start.offset_m, g.length_m(start.edge));
     double len = g.length_m(start.edge) - start.offset_m;
+    // Follow the turn graph as the searches do, so that a via-way restriction's copies count.
+    std::uint32_t vertex = start.edge.v;
     for (std::size_t i = 1; i < r.edges.size(); ++i) {
       const EdgeId e = r.edges[i];
       r.nodes.push_back(g.tail(e));
       r.arrival_s.push_back(t);
+      const auto [turn, next] = cost.turn_onto(vertex, e);
+      vertex = next;
       if (i + 1 < r.edges.size()) {
-        t = add_cost(t, cost.transit_s(e));
+        t = add_cost(t, add_cost(turn, cost.transit_s(e)));
         len += g.length_m(e);
       } else {
-        t = add_cost(t, add_cost(cost.node_delay_s(g.tail(e)), cost.partial_time_s(e, 0.0, goal.offset_m)));
+        t = add_cost(t, add_cost(turn, add_cost(cost.node_delay_s(g.tail(e)), cost.partial_time_s(e, 0.0, goal.offset_m))));
         len += goal.offset_m;
       }
     }

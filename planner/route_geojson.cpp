@@ -18,6 +18,7 @@ nlohmann::json steps_to_json(const maps::RoadGraph& graph, const Route& route) {
     nlohmann::json maneuver{{"type", to_string(s.maneuver)},
                             {"location", {round7(at.lon_deg), round7(at.lat_deg)}}};
     maneuver["modifier"] = s.modifier == TurnModifier::none ? nlohmann::json(nullptr) : nlohmann::json(to_string(s.modifier));
+    if (s.exit > 0) maneuver["exit"] = s.exit;
     out.push_back({{"name", s.name},
                    {"ref", s.ref},
                    {"distance_m", round1(s.distance_m)},

@@ -1,39 +1,25 @@
 #include "planner/route_steps.hpp"
 
+#include <algorithm>
 #include <cmath>
-#include <numbers>
+
+#include "maps/turn_graph.hpp"
 
 namespace corridor::planner {
 namespace {
 
-// Compass bearing (clockwise from north, degrees) of the direction a -> b in the local frame (x east,
-// y north).
-double bearing_deg(maps::Point2 a, maps::Point2 b) {
-  return std::atan2(b.x_m - a.x_m, b.y_m - a.y_m) * 180.0 / std::numbers::pi;
+double turn_between(const maps::RoadGraph& g, EdgeId in, EdgeId out) {
+  return maps::signed_turn_deg(maps::arriving_bearing_deg(g.geometry(in)), maps::leaving_bearing_deg(g.geometry(out)));
 }
 
-// Bearing leaving the edge's tail and arriving at its head, from the first and last pieces of its
-// geometry longer than a few centimetres.
-double leaving_bearing(const maps::RoadGraph& g, EdgeId e) {
-  const auto pts = g.geometry(e);
-  for (std::size_t i = 1; i < pts.size(); ++i) {
-    if (maps::distance_m(pts[0], pts[i]) > 0.05) return bearing_deg(pts[0], pts[i]);
+// The exits a vehicle passes from entering a roundabout by edges[first] until it leaves after
+// edges[last]: the roads leaving the ring at each node it reaches, the one it takes included.
+int roundabout_exit(const maps::RoadGraph& g, const std::vector<EdgeId>& edges, std::size_t first, std::size_t last) {
+  int exits = 0;
+  for (std::size_t k = first; k <= last; ++k) {
+    for (EdgeId f : g.out_edges(g.head(edges[k]))) exits += g.on_roundabout(f) ? 0 : 1;
   }
-  return bearing_deg(pts.front(), pts.back());
-}
-double arriving_bearing(const maps::RoadGraph& g, EdgeId e) {
-  const auto pts = g.geometry(e);
-  for (std::size_t i = pts.size() - 1; i-- > 0;) {
-    if (maps::distance_m(pts[i], pts.back()) > 0.05) return bearing_deg(pts[i], pts.back());
-  }
-  return bearing_deg(pts.front(), pts.back());
-}
-
-double signed_turn_deg(double from_bearing, double to_bearing) {
-  double d = std::fmod(to_bearing - from_bearing, 360.0);
-  if (d <= -180.0) d += 360.0;
-  if (d > 180.0) d -= 360.0;
-  return d;
+  return std::max(exits, 1);
 }
 
 }  // namespace
@@ -44,6 +30,7 @@ const char* to_string(ManeuverType t) {
     case ManeuverType::turn: return "turn";
     case ManeuverType::new_name: return "new name";
     case ManeuverType::continue_on: return "continue";
+    case ManeuverType::roundabout: return "roundabout";
     case ManeuverType::arrive: return "arrive";
   }
   return "turn";
@@ -99,20 +86,39 @@ std::vector<RouteStep> route_steps(const maps::RoadGraph& g, const Route& route,
   for (std::size_t i = 0; i < n; ++i) {
     if (i > 0) {
       const EdgeId in = route.edges[i - 1], out = route.edges[i];
-      const double turn = signed_turn_deg(arriving_bearing(g, in), leaving_bearing(g, out));
-      const bool renamed = g.name(in) != g.name(out) || g.ref(in) != g.ref(out);
-      const bool sharp = std::abs(turn) >= options.continue_turn_deg;
-      if (renamed || sharp) {
+      const bool entering = g.on_roundabout(out) && !g.on_roundabout(in);
+      const bool inside_or_leaving = g.on_roundabout(in);
+      if (entering) {
+        // One step for the whole roundabout, named after the road it leaves by.
+        std::size_t last = i;
+        while (last + 1 < n && g.on_roundabout(route.edges[last + 1])) ++last;
+        const EdgeId exit_road = last + 1 < n ? route.edges[last + 1] : route.edges[last];
         RouteStep s;
-        s.name = g.name(out);
-        s.ref = g.ref(out);
-        s.turn_deg = turn;
-        s.modifier = modifier_for_turn(turn);
-        s.maneuver = !renamed ? ManeuverType::continue_on
-                     : s.modifier == TurnModifier::straight ? ManeuverType::new_name
-                                                             : ManeuverType::turn;
+        s.name = g.name(exit_road);
+        s.ref = g.ref(exit_road);
+        s.maneuver = ManeuverType::roundabout;
+        s.exit = last + 1 < n ? roundabout_exit(g, route.edges, i, last) : 0;
+        s.turn_deg = maps::signed_turn_deg(maps::arriving_bearing_deg(g.geometry(in)),
+                                           maps::leaving_bearing_deg(g.geometry(exit_road)));
+        s.modifier = modifier_for_turn(s.turn_deg);
         s.location = g.position(g.tail(out));
         steps.push_back(s);
+      } else if (!inside_or_leaving) {
+        const double turn = turn_between(g, in, out);
+        const bool renamed = g.name(in) != g.name(out) || g.ref(in) != g.ref(out);
+        const bool sharp = std::abs(turn) >= options.continue_turn_deg;
+        if (renamed || sharp) {
+          RouteStep s;
+          s.name = g.name(out);
+          s.ref = g.ref(out);
+          s.turn_deg = turn;
+          s.modifier = modifier_for_turn(turn);
+          s.maneuver = !renamed ? ManeuverType::continue_on
+                       : s.modifier == TurnModifier::straight ? ManeuverType::new_name
+                                                               : ManeuverType::turn;
+          s.location = g.position(g.tail(out));
+          steps.push_back(s);
+        }
       }
     }
     steps.back().distance_m += piece_m(i);

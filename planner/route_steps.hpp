@@ -10,10 +10,11 @@
 
 namespace corridor::planner {
 
-enum class ManeuverType { depart, turn, new_name, continue_on, arrive };
+enum class ManeuverType { depart, turn, new_name, continue_on, roundabout, arrive };
 enum class TurnModifier { none, uturn, sharp_right, right, slight_right, straight, slight_left, left, sharp_left };
 
-const char* to_string(ManeuverType t);    // OSRM's words: "depart", "turn", "new name", "continue", "arrive"
+// OSRM's words: "depart", "turn", "new name", "continue", "roundabout", "arrive"
+const char* to_string(ManeuverType t);
 const char* to_string(TurnModifier m);    // "uturn", "sharp right", ..., or "" for none
 
 struct RouteStep {
@@ -25,6 +26,7 @@ struct RouteStep {
   TurnModifier modifier = TurnModifier::none;
   maps::Point2 location;  // where the maneuver happens
   double turn_deg = 0;    // signed turn angle at the maneuver, right positive
+  int exit = 0;           // for a roundabout: take the exit-th exit (1 = the first)
 };
 
 struct StepOptions {
@@ -35,7 +37,9 @@ struct StepOptions {
 // The modifier for a signed turn angle (right positive, degrees in (-180, 180]).
 TurnModifier modifier_for_turn(double turn_deg);
 
-// Depart, one step per street (or per sharp turn on one street), arrive. Empty for a route not found.
+// Depart, one step per street (or per sharp turn on one street), arrive. A roundabout is one step,
+// "roundabout" with the exit to take, named after the road it leaves by, as OSRM gives it. Empty for
+// a route not found.
 std::vector<RouteStep> route_steps(const maps::RoadGraph& graph, const Route& route, const StepOptions& options = {});
 
 }  // namespace corridor::planner

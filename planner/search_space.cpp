@@ -8,7 +8,7 @@
 namespace corridor::planner {
 
 SearchSpace::SearchSpace(const TravelCost& cost, std::vector<EdgePoint> starts, std::vector<EdgePoint> goals)
-    : cost_(&cost), node_count_(cost.graph().node_count()) {
+    : cost_(&cost), turns_(&cost.graph().turns()), turn_vertices_(turns_->vertex_count()) {
   normalize(goals, "goal");
   goals_ = std::move(goals);
   for (const EdgePoint& t : goals_) goal_tails_.push_back(cost.graph().tail(t.edge));

@@ -1,6 +1,8 @@
-// The graph a route search runs on: the road graph's nodes plus a virtual start vertex S and goal
-// vertex G, so that start and goal can be points on edges. Shared by Dijkstra, A* and D* Lite, so
-// the three use one cost model and can serve as each other's oracles.
+// The graph a route search runs on: the road graph's edge-based turn graph (maps/turn_graph.hpp),
+// a vertex per directed edge standing at its head, plus a virtual start vertex S and goal vertex G,
+// so that start and goal can be points on edges and every turn on the way is one the vehicle may
+// make. Shared by Dijkstra, A* and D* Lite, so the three use one cost model and can serve as each
+// other's oracles.
 #pragma once
 
 #include <algorithm>
@@ -13,7 +15,8 @@
 
 namespace corridor::planner {
 
-// Search vertices: graph node ids first, then S, then G.
+// Search vertices: the turn graph's vertices first (edges, then the copies via-way restrictions
+// need), then S, then G.
 using Vertex = StrongId<struct VertexTag, std::uint32_t, std::numeric_limits<std::uint32_t>::max()>;
 
 class SearchSpace {
@@ -22,18 +25,38 @@ class SearchSpace {
   // Throws std::invalid_argument for an empty list, an unknown edge, or a non-finite offset.
   SearchSpace(const TravelCost& cost, std::vector<EdgePoint> starts, std::vector<EdgePoint> goals);
 
-  [[nodiscard]] std::size_t vertex_count() const { return node_count_ + 2; }
-  [[nodiscard]] Vertex start() const { return Vertex{static_cast<std::uint32_t>(node_count_)}; }
-  [[nodiscard]] Vertex goal() const { return Vertex{static_cast<std::uint32_t>(node_count_ + 1)}; }
-  [[nodiscard]] bool is_node(Vertex v) const { return v.index() < node_count_; }
-  [[nodiscard]] static NodeId node(Vertex v) { return NodeId{v.v}; }
-  [[nodiscard]] static Vertex vertex(NodeId n) { return Vertex{n.v}; }
+  [[nodiscard]] std::size_t vertex_count() const { return turn_vertices_ + 2; }
+  [[nodiscard]] Vertex start() const { return Vertex{static_cast<std::uint32_t>(turn_vertices_)}; }
+  [[nodiscard]] Vertex goal() const { return Vertex{static_cast<std::uint32_t>(turn_vertices_ + 1)}; }
+  [[nodiscard]] bool is_turn_vertex(Vertex v) const { return v.index() < turn_vertices_; }
+  // The road edge a turn vertex has driven, and the intersection it stands at (its head).
+  [[nodiscard]] EdgeId edge(Vertex v) const { return turns_->edge_of(v.v); }
+  [[nodiscard]] NodeId node(Vertex v) const { return cost_->graph().head(edge(v)); }
+  // The vertex of having driven e (not one of its copies).
+  [[nodiscard]] static Vertex vertex(EdgeId e) { return Vertex{e.v}; }
+  // The vertices whose arcs' costs a change to edge e's conditions changes: every source of a turn
+  // onto e or onto one of its copies. f(Vertex).
+  template <class F>
+  void for_each_vertex_turning_onto(EdgeId e, F&& f) const {
+    for (const maps::TurnArc& a : turns_->arcs_in(e.v)) f(Vertex{a.other});
+    for (std::uint32_t c : turns_->copies_of(e)) {
+      for (const maps::TurnArc& a : turns_->arcs_in(c)) f(Vertex{a.other});
+    }
+  }
+  // The vertices standing at node n (whose arcs cross it): its in-edges and their copies.
+  template <class F>
+  void for_each_vertex_at(NodeId n, F&& f) const {
+    for (EdgeId e : cost_->graph().in_edges(n)) {
+      f(vertex(e));
+      for (std::uint32_t c : turns_->copies_of(e)) f(Vertex{c});
+    }
+  }
 
   [[nodiscard]] std::span<const EdgePoint> starts() const { return starts_; }
   [[nodiscard]] std::span<const EdgePoint> goals() const { return goals_; }
   void set_starts(std::vector<EdgePoint> starts);
 
-  // The road nodes S's arcs lead to and G's arcs come from.
+  // The road nodes S's arcs lead to and G's arcs come from (sorted).
   [[nodiscard]] std::span<const NodeId> start_heads() const { return start_heads_; }
   [[nodiscard]] std::span<const NodeId> goal_tails() const { return goal_tails_; }
 
@@ -42,13 +65,13 @@ class SearchSpace {
   // through a goal tail, and the arcs from S and to G cost at least 0, so the minimum of the
   // landmark bound over those nodes is admissible; a minimum of consistent bounds is consistent.
   [[nodiscard]] double h_from_start_s(Vertex v) const {
-    if (!is_node(v)) return 0.0;
+    if (!is_turn_vertex(v)) return 0.0;
     double best = kInfCost;
     for (NodeId a : start_heads_) best = std::min(best, cost_->lower_bound_s(a, node(v)));
     return best;
   }
   [[nodiscard]] double h_to_goal_s(Vertex v) const {
-    if (!is_node(v)) return 0.0;
+    if (!is_turn_vertex(v)) return 0.0;
     double best = kInfCost;
     for (NodeId b : goal_tails_) best = std::min(best, cost_->lower_bound_s(node(v), b));
     return best;
@@ -61,13 +84,13 @@ class SearchSpace {
   [[nodiscard]] const TravelCost& cost() const { return *cost_; }
 
   // f(Vertex to, double cost_s, EdgeId via) for every arc out of u. `via` is the road edge the arc
-  // drives on (for S and G arcs, the start or goal edge).
+  // drives on (for S and G arcs, the start or goal edge). Turns the vehicle may not make are left out.
   template <class F>
   void for_each_successor(Vertex u, F&& f) const {
     const auto& g = cost_->graph();
     if (u == start()) {
       for (const EdgePoint& s : starts_) {
-        f(vertex(g.head(s.edge)), cost_->partial_time_s(s.edge, s.offset_m, g.length_m(s.edge)), s.edge);
+        f(vertex(s.edge), cost_->partial_time_s(s.edge, s.offset_m, g.length_m(s.edge)), s.edge);
         for (const EdgePoint& t : goals_) {
           if (t.edge == s.edge && t.offset_m >= s.offset_m) f(goal(), cost_->partial_time_s(s.edge, s.offset_m, t.offset_m), s.edge);
         }
@@ -76,9 +99,17 @@ class SearchSpace {
     }
     if (u == goal()) return;
     const NodeId n = node(u);
-    for (EdgeId e : g.out_edges(n)) f(vertex(g.head(e)), cost_->transit_s(e), e);
-    for (const EdgePoint& t : goals_) {
-      if (g.tail(t.edge) == n) f(goal(), goal_arc_s(t), t.edge);
+    const bool at_goal_tail = std::binary_search(goal_tails_.begin(), goal_tails_.end(), n);
+    for (const maps::TurnArc& a : turns_->arcs_out(u.v)) {
+      const double turn = cost_->turn_s(a);
+      if (turn >= kInfCost) continue;
+      const Vertex v{a.other};
+      const EdgeId onto = edge(v);
+      f(v, add_cost(turn, cost_->transit_s(onto)), onto);
+      if (!at_goal_tail) continue;
+      for (const EdgePoint& t : goals_) {
+        if (t.edge == onto) f(goal(), add_cost(turn, goal_arc_s(t)), onto);
+      }
     }
   }
 
@@ -88,7 +119,17 @@ class SearchSpace {
     const auto& g = cost_->graph();
     if (v == start()) return;
     if (v == goal()) {
-      for (const EdgePoint& t : goals_) f(vertex(g.tail(t.edge)), goal_arc_s(t));
+      for (const EdgePoint& t : goals_) {
+        const double arc = goal_arc_s(t);
+        auto from_turns_into = [&](std::uint32_t x) {
+          for (const maps::TurnArc& a : turns_->arcs_in(x)) {
+            const double turn = cost_->turn_s(a);
+            if (turn < kInfCost) f(Vertex{a.other}, add_cost(turn, arc));
+          }
+        };
+        from_turns_into(t.edge.v);
+        for (std::uint32_t c : turns_->copies_of(t.edge)) from_turns_into(c);
+      }
       for (const EdgePoint& s : starts_) {
         for (const EdgePoint& t : goals_) {
           if (t.edge == s.edge && t.offset_m >= s.offset_m) f(start(), cost_->partial_time_s(s.edge, s.offset_m, t.offset_m));
@@ -96,10 +137,16 @@ class SearchSpace {
       }
       return;
     }
-    const NodeId n = node(v);
-    for (EdgeId e : g.in_edges(n)) f(vertex(g.tail(e)), cost_->transit_s(e));
-    for (const EdgePoint& s : starts_) {
-      if (g.head(s.edge) == n) f(start(), cost_->partial_time_s(s.edge, s.offset_m, g.length_m(s.edge)));
+    const EdgeId e = edge(v);
+    const double drive = cost_->transit_s(e);
+    for (const maps::TurnArc& a : turns_->arcs_in(v.v)) {
+      const double turn = cost_->turn_s(a);
+      if (turn < kInfCost) f(Vertex{a.other}, add_cost(turn, drive));
+    }
+    if (v == vertex(e)) {
+      for (const EdgePoint& s : starts_) {
+        if (s.edge == e) f(start(), cost_->partial_time_s(s.edge, s.offset_m, g.length_m(s.edge)));
+      }
     }
   }
 
@@ -119,7 +166,8 @@ class SearchSpace {
   void normalize(std::vector<EdgePoint>& points, const char* what) const;
 
   const TravelCost* cost_;
-  std::size_t node_count_;
+  const maps::TurnGraph* turns_;
+  std::size_t turn_vertices_;
   std::vector<EdgePoint> starts_;
   std::vector<EdgePoint> goals_;
   std::vector<NodeId> start_heads_;

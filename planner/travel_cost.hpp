@@ -1,18 +1,18 @@
-// The planner's cost model: edge travel time from length, speed, vehicle max speed, congestion and
-// queue delay; node crossing delay; and the admissible landmark (ALT) heuristic.
+// The planner's cost model: edge travel time from length, speed, the vehicle's profile, congestion
+// and queue delay; node crossing delay; the cost of each turn (angle, crossing traffic, U-turn,
+// restrictions); and the admissible landmark (ALT) heuristic.
 #pragma once
 
 #include <algorithm>
+#include <array>
+#include <vector>
 
 #include "maps/road_graph.hpp"
 #include "planner/cost.hpp"
 #include "planner/cost_overlay.hpp"
+#include "planner/vehicle_profile.hpp"
 
 namespace corridor::planner {
-
-struct VehicleProfile {
-  double vmax_mps = 120.0 / 3.6;
-};
 
 // A point on a directed edge, `offset_m` from its tail in the edge's length units.
 struct EdgePoint {
@@ -22,15 +22,20 @@ struct EdgePoint {
 
 class TravelCost {
  public:
-  // Throws CostUpdateError when vmax is not a positive finite speed.
+  // Throws CostUpdateError when vmax is not a positive finite speed, ProfileError for another value
+  // out of range.
   TravelCost(const maps::RoadGraph& graph, const CostOverlay& overlay, VehicleProfile vehicle);
 
   // length / min(edge speed, vmax) × congestion factor, and never below that free-flow time:
   // congestion only slows a vehicle down. A factor below 1 (traffic measured faster than the legal
   // speed) counts as 1, which keeps free flow at the legal speed a lower bound of every edge's
   // cost, as the landmark heuristic requires.
+  // An edge the vehicle does not fit (maxheight, maxwidth, maxweight) costs kInfCost.
   [[nodiscard]] double running_time_s(EdgeId e) const {
-    const double free_flow = graph_->length_m(e) / std::min(graph_->speed_mps(e), vmax_mps_);
+    if (!blocked_.empty() && blocked_[e.index()] != 0) return kInfCost;
+    double speed = graph_->speed_mps(e);
+    if (scaled_speeds_) speed *= profile_.speed_factor[static_cast<std::size_t>(graph_->road_class(e))];
+    const double free_flow = graph_->length_m(e) / std::min(speed, vmax_mps_);
     return free_flow * std::max(overlay_->edge(e).congestion_factor, 1.0);
   }
   [[nodiscard]] double edge_time_s(EdgeId e) const { return add_cost(running_time_s(e), overlay_->edge(e).queue_delay_s); }
@@ -39,6 +44,27 @@ class TravelCost {
   // Crossing the tail intersection, then driving the edge: the weight of a graph edge. Folding the
   // node cost into its out-edges makes node costs exact for every path through the node.
   [[nodiscard]] double transit_s(EdgeId e) const { return add_cost(node_delay_s(graph_->tail(e)), edge_time_s(e)); }
+
+  // The cost of a turn of the edge-based graph (maps/turn_graph.hpp) beyond the edges it joins:
+  // kInfCost for a turn a binding restriction forbids or a U-turn the profile does not allow; the
+  // U-turn penalty; otherwise the angle's cost plus the crossing penalty for a turn across
+  // oncoming traffic. Never negative, so free flow stays a lower bound.
+  [[nodiscard]] double turn_s(const maps::TurnArc& a) const {
+    if (a.plain()) return angle_cost_s_[static_cast<std::size_t>(a.angle_deg + 180)];
+    if ((a.ban_modes() & restriction_modes_) != 0 ||
+        (!profile_.emergency_exceptions && (a.ban_modes_except_emergency() & restriction_modes_) != 0)) {
+      return kInfCost;
+    }
+    if (a.uturn()) {
+      if (!a.dead_end() && profile_.uturn_policy == UturnPolicy::dead_ends) return kInfCost;
+      return profile_.uturn_penalty_s;
+    }
+    return angle_cost_s_[static_cast<std::size_t>(a.angle_deg + 180)];
+  }
+
+  // The turn from turn-graph vertex `from` onto edge `next`: its turn_s (kInfCost when the graph has
+  // no such turn) and the vertex it leads to (a copy of next, where a via-way restriction needs it).
+  [[nodiscard]] std::pair<double, std::uint32_t> turn_onto(std::uint32_t from, EdgeId next) const;
 
   // Driving from offset `from_m` to `to_m` on e. The queue delay is spread along the edge in
   // proportion to distance: a position fix cannot tell whether a vehicle near the stop line is
@@ -53,11 +79,19 @@ class TravelCost {
   [[nodiscard]] const maps::RoadGraph& graph() const { return *graph_; }
   [[nodiscard]] const CostOverlay& overlay() const { return *overlay_; }
   [[nodiscard]] double vmax_mps() const { return vmax_mps_; }
+  [[nodiscard]] const VehicleProfile& profile() const { return profile_; }
+  // True when the vehicle does not fit on e.
+  [[nodiscard]] bool blocked(EdgeId e) const { return !blocked_.empty() && blocked_[e.index()] != 0; }
 
  private:
   const maps::RoadGraph* graph_;
   const CostOverlay* overlay_;
+  VehicleProfile profile_;
   double vmax_mps_;
+  std::uint8_t restriction_modes_;
+  bool scaled_speeds_;
+  std::array<double, 361> angle_cost_s_{};  // by signed angle + 180
+  std::vector<std::uint8_t> blocked_;      // by edge; empty when no limit binds the vehicle
 };
 
 }  // namespace corridor::planner

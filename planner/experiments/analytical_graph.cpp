@@ -150,6 +150,9 @@ AnalyticalGraph parse(std::string_view json_text, const std::string& origin) {
     }
   }
   maps::build_reverse_adjacency(d);
+  // The seed's hand-made graphs are abstract links with times, not streets: no turn has a cost or
+  // a rule, as in the paper.
+  d.turns_in_edges = {1};
 
   const std::string source = text(doc, "source", "the graph", origin);
   const std::string destination = text(doc, "destination", "the graph", origin);

@@ -83,6 +83,15 @@ class Vehicle {
       time_s_ += s_.signal_delay_s[at_.index()];
       r.signal_wait_s += s_.signal_delay_s[at_.index()];
     }
+    // The turn onto e costs what the planner charges for it (angle, crossing traffic).
+    std::uint32_t vertex = e.v;
+    if (!r.driven.empty()) {
+      const auto [turn, next] = cost_.turn_onto(vertex_, e);
+      if (turn >= kInfCost) throw std::logic_error("trip simulator: route takes a turn the vehicle may not make");
+      time_s_ += turn;
+      vertex = next;
+    }
+    vertex_ = vertex;
     time_s_ += cost_.running_time_s(e) + queue;
     r.queue_wait_s += queue;
     r.driven.push_back(e);
@@ -99,6 +108,7 @@ class Vehicle {
   const TravelCost& cost_;
   const std::vector<CongestionEvent>& events_;
   NodeId at_;
+  std::uint32_t vertex_ = 0;  // the turn-graph vertex of the last edge driven
   double time_s_ = 0.0;
 };
 

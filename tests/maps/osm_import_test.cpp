@@ -13,17 +13,11 @@
 namespace corridor::maps {
 namespace {
 
+using testing::at;
 using testing::FixtureNode;
 using testing::FixtureWay;
 using testing::TempDir;
 using testing::write_osm;
-
-// A node `x_m` east and `y_m` north of (47.0, 9.5).
-FixtureNode at(long long id, double x_m, double y_m, std::map<std::string, std::string> tags = {}) {
-  constexpr double kMetersPerDegLat = 111195.0;
-  const double lon_scale = kMetersPerDegLat * std::cos(47.0 * M_PI / 180.0);
-  return {id, 47.0 + y_m / kMetersPerDegLat, 9.5 + x_m / lon_scale, std::move(tags)};
-}
 
 NodeId node_by_osm(const RoadGraph& g, long long osm) {
   for (NodeId v : g.nodes()) {
@@ -343,7 +337,6 @@ TEST(OsmImport, BlockingNodeForms) {
            {{"barrier", "wall"}},
            {{"barrier", "fence"}},
            {{"barrier", "kerb"}},
-           {{"barrier", "height_restrictor"}, {"maxheight", "2.3"}},
            {{"barrier", "gate"}, {"access", "no"}},
            {{"access", "no"}},
            {{"motor_vehicle", "no"}},
@@ -351,6 +344,38 @@ TEST(OsmImport, BlockingNodeForms) {
     const auto g = street_with_node(tags);
     EXPECT_EQ(nodes_by_osm(g, 2).size(), 2u) << tags.begin()->first << "=" << tags.begin()->second;
     EXPECT_FALSE(street_passes(g));
+  }
+}
+
+// A height restrictor is not a barrier for every vehicle: the roads through it carry its maxheight,
+// and the vehicle profile decides (a 2.9 m ambulance passes 3.2 m, a 3.5 m fire engine does not).
+TEST(OsmImport, HeightRestrictorBecomesALimitOnItsRoads) {
+  const auto g = street_with_node({{"barrier", "height_restrictor"}, {"maxheight", "3.2"}});
+  EXPECT_TRUE(nodes_by_osm(g, 2).empty());
+  EXPECT_TRUE(street_passes(g));
+  const EdgeId ab = edge_between(g, 1, 3), ba = edge_between(g, 3, 1);
+  ASSERT_TRUE(ab.valid() && ba.valid());
+  std::vector<EdgeId> limited;
+  for (const EdgeLimit& l : g.edge_limits()) {
+    EXPECT_FLOAT_EQ(l.max_height_m, 3.2f);
+    limited.push_back(l.edge);
+  }
+  std::sort(limited.begin(), limited.end());
+  EXPECT_EQ(limited, (std::vector<EdgeId>{std::min(ab, ba), std::max(ab, ba)}));
+}
+
+TEST(OsmImport, WayLimitsAreKeptPerEdge) {
+  const auto g = import_fixture({at(1, 0, 0), at(2, 100, 0), at(3, 100, 100), at(4, 0, 100)},
+                                {{90, {1, 2}, {{"highway", "residential"}, {"maxweight", "7.5"}, {"maxwidth", "2.0"}}},
+                                 {91, {2, 3, 4, 1}, kResidential}});
+  const EdgeId e = edge_between(g, 1, 2);
+  ASSERT_TRUE(e.valid());
+  ASSERT_EQ(g.edge_limits().size(), 2u);
+  for (const EdgeLimit& l : g.edge_limits()) {
+    EXPECT_TRUE(l.edge == e || l.edge == edge_between(g, 2, 1));
+    EXPECT_FLOAT_EQ(l.max_weight_t, 7.5f);
+    EXPECT_FLOAT_EQ(l.max_width_m, 2.0f);
+    EXPECT_EQ(l.max_height_m, 0.0f);
   }
 }
 

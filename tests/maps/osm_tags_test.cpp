@@ -265,15 +265,35 @@ TEST(NodeRules, BarriersAsACarProfileReadsThem) {
   EXPECT_TRUE(blocks("gate", "access", "no"));
   EXPECT_FALSE(blocks("gate", "access", "private"));  // private does not stop an emergency vehicle
   EXPECT_FALSE(blocks("block", "emergency", "yes"));
-  EXPECT_FALSE(blocks("height_restrictor"));  // no height given
-  EXPECT_TRUE(blocks("height_restrictor", "maxheight", "2.5"));
-  EXPECT_TRUE(blocks("height_restrictor", "maxheight", "9'6\""));  // 2.90 m
-  EXPECT_FALSE(blocks("height_restrictor", "maxheight", "3.2 m"));
-  EXPECT_FALSE(blocks("height_restrictor", "maxheight", "default"));
-  NodeTags t;
-  t.barrier = "height_restrictor";
-  t.maxheight = "3.2";
-  EXPECT_TRUE(node_blocks_emergency(t, 3.5));  // a fire engine
+  // A height restrictor becomes a limit on its roads, which the vehicle profile checks.
+  EXPECT_FALSE(blocks("height_restrictor"));
+  EXPECT_FALSE(blocks("height_restrictor", "maxheight", "2.5"));
+}
+
+TEST(WayRules, PhysicalLimitsAreReadNotJudged) {
+  WayTags t;
+  t.highway = "residential";
+  t.maxheight = "3.2 m";
+  t.maxwidth = "2.2";
+  t.maxweight = "7500 kg";
+  const auto r = interpret_way(t);
+  ASSERT_TRUE(r.has_value());
+  EXPECT_DOUBLE_EQ(r->max_height_m, 3.2);
+  EXPECT_DOUBLE_EQ(r->max_width_m, 2.2);
+  EXPECT_DOUBLE_EQ(r->max_weight_t, 7.5);
+  t.maxheight = "default";
+  t.maxwidth = "none";
+  t.maxweight = "heavy";
+  const auto none = interpret_way(t);
+  EXPECT_EQ(none->max_height_m, 0.0);
+  EXPECT_EQ(none->max_width_m, 0.0);
+  EXPECT_EQ(none->max_weight_t, 0.0);
+  EXPECT_NEAR(*parse_length_m("9'6\""), 2.8956, 1e-9);
+  EXPECT_NEAR(*parse_length_m("12 ft"), 3.6576, 1e-9);
+  EXPECT_NEAR(*parse_weight_t("10 st"), 9.0718474, 1e-9);
+  EXPECT_DOUBLE_EQ(*parse_weight_t("15"), 15.0);
+  EXPECT_FALSE(parse_weight_t("15 stone").has_value());
+  EXPECT_FALSE(parse_length_m("-3").has_value());
 }
 
 }  // namespace

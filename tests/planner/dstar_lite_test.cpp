@@ -41,12 +41,15 @@ void expect_matches_dijkstra(const DStarLite& dstar, const TravelCost& cost, con
   }
 }
 
+// On edge-based graphs with random turn restrictions (via node and via way), under profiles that
+// differ in what binds them and in their turn and U-turn costs.
 TEST(DStarLite, InitialPlanMatchesDijkstraOnRandomGraphs) {
   for (std::uint64_t seed = 1; seed <= 60; ++seed) {
-    const auto g = random_grid(seed, 8, 9);
+    const auto grid = random_grid(seed, 8, 9);
+    const auto g = testing::with_random_restrictions(grid, seed, grid.edge_count() / 6);
     CostOverlay overlay(g);
     overlay.set_signal_delay(g, 7.5);
-    const TravelCost cost(g, overlay, {30.0});
+    const TravelCost cost(g, overlay, testing::oracle_profile(seed, 30.0));
     std::mt19937_64 rng(seed);
     for (int q = 0; q < 10; ++q) {
       const auto starts = with_twin(g, random_point(g, rng));
@@ -64,9 +67,10 @@ TEST(DStarLite, ReplanMatchesDijkstraAfterRandomUpdateSequences) {
   int replans = 0;
   constexpr std::uint64_t kSequences = 200;
   for (std::uint64_t seed = 1; seed <= kSequences; ++seed) {
-    const auto g = random_grid(seed, 7, 7 + seed % 4);
+    const auto grid = random_grid(seed, 7, 7 + seed % 4);
+    const auto g = testing::with_random_restrictions(grid, seed, grid.edge_count() / 8);
     CostOverlay overlay(g);
-    const TravelCost cost(g, overlay, {25.0});
+    const TravelCost cost(g, overlay, testing::oracle_profile(seed, 25.0));
     std::mt19937_64 rng(seed * 7919);
     std::uniform_real_distribution<double> unit(0.0, 1.0);
     auto starts = with_twin(g, random_point(g, rng));
@@ -194,7 +198,7 @@ TEST(DStarLite, MovingAlongTheRouteKeepsTheRestOfIt) {
 TEST(DStarLite, UnreachableGoalAndRecovery) {
   const auto g = testing::diamond();
   CostOverlay overlay(g);
-  const TravelCost cost(g, overlay, {30.0});
+  const TravelCost cost(g, overlay, testing::free_turns(30.0));
   const EdgeId ba = testing::edge_from_to(g, 2, 1), bc = testing::edge_from_to(g, 2, 3);
   const std::vector<EdgeId> closed{testing::edge_from_to(g, 1, 2), testing::edge_from_to(g, 1, 4)};
   for (EdgeId e : closed) overlay.close_edge(e);

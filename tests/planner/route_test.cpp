@@ -23,7 +23,7 @@ TEST(Route, ArrivalTimesAndCostToGoalAlongTheRoute) {
   const auto g = diamond();
   CostOverlay overlay(g);
   overlay.set_node_delay(NodeId{g.head(edge_from_to(g, 1, 4))}, 4.0);  // D
-  const TravelCost cost(g, overlay, {30.0});
+  const TravelCost cost(g, overlay, testing::free_turns(30.0));
   const EdgeId ba = edge_from_to(g, 2, 1), ad = edge_from_to(g, 1, 4), dc = edge_from_to(g, 4, 3);
   const Route r = make_route(cost, {ba, 40.0}, {ba, ad, dc}, {dc, g.length_m(dc) / 2});
   ASSERT_TRUE(r.found);
@@ -113,12 +113,14 @@ TEST(SnapPoints, NodeCoordinatesOfferEveryEdgeAtTheNode) {
 
 // The detour the nearest-segment snap made: from a junction, a route must cost exactly the
 // node-to-node shortest path, whichever edge of the junction the snap returned. Oracle: Dijkstra
-// from the start node over graph edges, on random grids with one-way streets.
+// from the start node over graph edges, on random grids with one-way streets. With free turns (no
+// turn cost, U-turns anywhere) the edge-based search graph must give exactly these node-to-node
+// costs, which also checks the edge-based graph against the node-based one.
 TEST(SnapPoints, RoutesBetweenJunctionsCostTheNodeToNodeShortestPath) {
   for (std::uint64_t seed = 1; seed <= 6; ++seed) {
     const auto g = testing::random_grid(seed, 8, 8);
     const CostOverlay overlay(g);
-    const TravelCost cost(g, overlay, {30.0});
+    const TravelCost cost(g, overlay, testing::free_turns(30.0));
     std::mt19937_64 rng(seed);
     for (int trial = 0; trial < 20; ++trial) {
       const EdgeId se{std::uniform_int_distribution<std::uint32_t>(0, static_cast<std::uint32_t>(g.edge_count() - 1))(rng)};

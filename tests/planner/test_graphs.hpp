@@ -19,6 +19,57 @@ inline maps::RoadGraph random_grid(std::uint64_t seed, std::uint32_t rows, std::
   return maps::make_perturbed_grid(spec);
 }
 
+// A profile under which the edge-based graph behaves as the node-based one: turns cost nothing and
+// a U-turn is allowed anywhere. For tests whose expected costs are worked out node by node.
+inline VehicleProfile free_turns(double vmax_mps) {
+  VehicleProfile p;
+  p.vmax_mps = vmax_mps;
+  p.turn_penalty_s = 0;
+  p.crossing_penalty_s = 0;
+  p.uturn_policy = UturnPolicy::anywhere;
+  p.uturn_penalty_s = 0;
+  return p;
+}
+
+// The graph with random turn restrictions added: via-node and via-way (two to three via edges), no_
+// and only_, of every mode, some lifted for emergency vehicles. What binds is the profile's business.
+inline maps::RoadGraph with_random_restrictions(const maps::RoadGraph& g, std::uint64_t seed, std::size_t count) {
+  std::mt19937_64 rng(seed);
+  maps::RoadGraphData d = g.data();
+  d.restrictions = {};
+  std::uniform_int_distribution<std::uint32_t> any_edge(0, static_cast<std::uint32_t>(g.edge_count() - 1));
+  for (std::size_t k = 0; k < count; ++k) {
+    std::vector<EdgeId> path{EdgeId{any_edge(rng)}};
+    const int length = std::uniform_int_distribution<int>(2, 4)(rng) == 2 ? 2 : std::uniform_int_distribution<int>(3, 5)(rng);
+    while (static_cast<int>(path.size()) < length) {
+      std::vector<EdgeId> next;
+      for (EdgeId f : g.out_edges(g.head(path.back()))) {
+        if (f != g.twin(path.back()) || std::uniform_int_distribution<int>(0, 4)(rng) == 0) next.push_back(f);
+      }
+      if (next.empty()) break;
+      path.push_back(next[std::uniform_int_distribution<std::size_t>(0, next.size() - 1)(rng)]);
+    }
+    if (path.size() < 2) continue;
+    const auto mode = static_cast<maps::RestrictionMode>(std::uniform_int_distribution<int>(0, 5)(rng));
+    d.restrictions.add(path, std::uniform_int_distribution<int>(0, 3)(rng) == 0, mode,
+                       std::uniform_int_distribution<int>(0, 3)(rng) == 0);
+  }
+  return maps::RoadGraph(std::move(d));
+}
+
+// The profiles the randomized oracles cycle through: the ambulance, a fire engine, free turns, and
+// U-turns anywhere at a price.
+inline VehicleProfile oracle_profile(std::uint64_t seed, double vmax_mps) {
+  VehicleProfile p = seed % 4 == 1 ? fire_engine_profile() : seed % 4 == 2 ? free_turns(vmax_mps) : ambulance_profile();
+  if (seed % 4 == 3) {
+    p.uturn_policy = UturnPolicy::anywhere;
+    p.uturn_penalty_s = 12.0;
+    p.emergency_exceptions = false;
+  }
+  p.vmax_mps = vmax_mps;
+  return p;
+}
+
 inline EdgePoint random_point(const maps::RoadGraph& g, std::mt19937_64& rng) {
   const EdgeId e{std::uniform_int_distribution<std::uint32_t>(0, static_cast<std::uint32_t>(g.edge_count() - 1))(rng)};
   // Offsets at the ends are the interesting corner cases; pick them often.

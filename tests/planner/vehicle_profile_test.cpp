@@ -1,0 +1,71 @@
+#include "planner/vehicle_profile.hpp"
+
+#include <gtest/gtest.h>
+
+#include "planner/travel_cost.hpp"
+#include "tests/planner/test_graphs_line.hpp"
+
+namespace corridor::planner {
+namespace {
+
+const std::filesystem::path kProfiles = std::filesystem::path(CORRIDOR_SOURCE_DIR) / "planner" / "profiles";
+
+TEST(VehicleProfile, ShippedFilesAreTheBuiltInProfiles) {
+  EXPECT_EQ(profile_to_json(load_profile(kProfiles / "ambulance.json")), profile_to_json(ambulance_profile()));
+  EXPECT_EQ(profile_to_json(load_profile(kProfiles / "fire_engine.json")), profile_to_json(fire_engine_profile()));
+  EXPECT_EQ(builtin_profile("fire_engine").height_m, 3.5);
+  EXPECT_THROW(builtin_profile("tank"), ProfileError);
+}
+
+TEST(VehicleProfile, JsonOverridesABase) {
+  const auto p = profile_from_json(R"({"base": "fire_engine", "name": "ladder", "height_m": 3.9, "uturn": "anywhere",
+                                       "restriction_modes": ["all", "hgv"], "speed_factor": {"residential": 0.7}})");
+  EXPECT_EQ(p.name, "ladder");
+  EXPECT_EQ(p.height_m, 3.9);
+  EXPECT_EQ(p.weight_t, 15.0);  // from the base
+  EXPECT_EQ(p.uturn_policy, UturnPolicy::anywhere);
+  EXPECT_EQ(p.restriction_modes, maps::mode_bit(maps::RestrictionMode::all) | maps::mode_bit(maps::RestrictionMode::hgv));
+  EXPECT_EQ(p.speed_factor[static_cast<std::size_t>(maps::RoadClass::residential)], 0.7);
+  // The JSON written back reads as the same profile.
+  EXPECT_EQ(profile_to_json(profile_from_json(profile_to_json(p))), profile_to_json(p));
+}
+
+TEST(VehicleProfile, BadJsonIsAClearError) {
+  auto error_of = [](const char* json) {
+    try {
+      (void)profile_from_json(json);
+    } catch (const ProfileError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(error_of("{").find("not valid JSON"), std::string::npos);
+  EXPECT_NE(error_of("[]").find("object"), std::string::npos);
+  EXPECT_NE(error_of(R"({"height": 3})").find("unknown key 'height'"), std::string::npos);
+  EXPECT_NE(error_of(R"({"height_m": "tall"})").find("'height_m' must be a number"), std::string::npos);
+  EXPECT_NE(error_of(R"({"height_m": -1})").find("height_m"), std::string::npos);
+  EXPECT_NE(error_of(R"({"vmax_kmh": 0})").find("vmax"), std::string::npos);
+  EXPECT_NE(error_of(R"({"uturn": "sometimes"})").find("uturn"), std::string::npos);
+  EXPECT_NE(error_of(R"({"restriction_modes": ["tram"]})").find("unknown restriction mode"), std::string::npos);
+  EXPECT_NE(error_of(R"({"speed_factor": {"residential": 1.5}})").find("(0, 1]"), std::string::npos);
+  EXPECT_NE(error_of(R"({"speed_factor": {"lane": 0.5}})").find("unknown road class"), std::string::npos);
+  EXPECT_NE(error_of(R"({"base": "tank"})").find("unknown vehicle profile"), std::string::npos);
+  EXPECT_THROW((void)load_profile("/nonexistent/profile.json"), ProfileError);
+}
+
+TEST(VehicleProfile, SpeedFactorSlowsItsRoadClassOnly) {
+  const auto g = testing::diamond();  // residential roads
+  const EdgeId ab = testing::edge_from_to(g, 1, 2);
+  ASSERT_EQ(g.road_class(ab), maps::RoadClass::residential);
+  const CostOverlay overlay(g);
+  VehicleProfile p;
+  p.vmax_mps = 30.0;
+  EXPECT_DOUBLE_EQ(TravelCost(g, overlay, p).running_time_s(ab), 10.0);
+  p.speed_factor[static_cast<std::size_t>(maps::RoadClass::motorway)] = 0.5;
+  EXPECT_DOUBLE_EQ(TravelCost(g, overlay, p).running_time_s(ab), 10.0);
+  p.speed_factor[static_cast<std::size_t>(maps::RoadClass::residential)] = 0.5;
+  EXPECT_DOUBLE_EQ(TravelCost(g, overlay, p).running_time_s(ab), 20.0);
+}
+
+}  // namespace
+}  // namespace corridor::planner
