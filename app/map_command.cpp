@@ -21,18 +21,26 @@ nlohmann::json describe(const maps::RoadGraph& g) {
   return {{"nodes", g.node_count()},
           {"edges", g.edge_count()},
           {"signalized_nodes", signals},
-          {"bbox", {lo.lon_deg, lo.lat_deg, hi.lon_deg, hi.lat_deg}}};
+          {"bbox", {lo.lon_deg, lo.lat_deg, hi.lon_deg, hi.lat_deg}},
+          {"turn_restrictions", g.data().restrictions.size()},
+          {"turns", g.turns().arc_count()},
+          {"restriction_copies", g.turns().copy_count()},
+          {"limited_edges", g.edge_limits().size()},
+          {"traffic_keeps", g.left_hand_traffic() ? "left" : "right"}};
 }
 
 struct ImportOptions {
   std::string input;
   std::string output;
+  bool left_hand_traffic = false;
 };
 
 void run_import(const ImportOptions& o) {
   const auto t0 = std::chrono::steady_clock::now();
   maps::OsmImportReport report;
-  const maps::RoadGraph graph = maps::import_osm(o.input, {}, &report);
+  maps::OsmImportOptions import;
+  import.left_hand_traffic = o.left_hand_traffic;
+  const maps::RoadGraph graph = maps::import_osm(o.input, import, &report);
   const double import_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   maps::write_graph_cache(o.output, graph, maps::describe_source(o.input));
   const auto t1 = std::chrono::steady_clock::now();
@@ -47,6 +55,8 @@ void run_import(const ImportOptions& o) {
   j["osm_ways_kept"] = report.osm_ways_kept;
   j["osm_signal_nodes"] = report.osm_signal_nodes;
   j["osm_barrier_nodes"] = report.osm_barrier_nodes;
+  j["osm_restrictions_applied"] = report.osm_restrictions_applied;
+  j["osm_restrictions_unresolved"] = report.osm_restrictions_unresolved;
   j["graph_nodes_before_scc"] = report.graph.input_nodes;
   j["dropped_nodes_outside_largest_scc"] = report.graph.dropped_nodes;
   j["strongly_connected_components"] = report.graph.components;
@@ -76,6 +86,8 @@ void register_map_command(CLI::App& app) {
   auto* import_cmd = map->add_subcommand("import", "Import an OSM file and write a graph cache");
   import_cmd->add_option("--input", import_options->input, "OSM file (.osm, .osm.gz, .osm.bz2, .osm.pbf)")->required();
   import_cmd->add_option("--out", import_options->output, "graph cache to write")->required();
+  import_cmd->add_flag("--left-hand-traffic", import_options->left_hand_traffic,
+                       "traffic keeps left (a right turn crosses oncoming traffic)");
   import_cmd->callback([import_options] { run_import(*import_options); });
 
   auto info_options = std::make_shared<MapOptions>();

@@ -25,10 +25,13 @@ void add_map_options(CLI::App& cmd, MapOptions& options) {
                  "OSM file (.osm, .osm.gz, .osm.bz2, .osm.pbf) or graph cache; default: the embedded Monaco map");
   cmd.add_option("--cache-dir", options.cache_dir, "where imported graphs are cached (default ~/.cache/corridor)");
   cmd.add_flag("--no-cache", options.no_cache, "import the map without reading or writing a cache");
+  cmd.add_flag("--left-hand-traffic", options.left_hand_traffic,
+               "traffic keeps left (UK, Japan, ...): a right turn crosses oncoming traffic");
 }
 
 maps::RoadGraph load_map_from_options(const MapOptions& options, maps::MapLoadInfo* info) {
   maps::MapLoadOptions load;
+  load.import.left_hand_traffic = options.left_hand_traffic;
   if (!options.no_cache) {
     load.cache_dir = options.cache_dir.empty() ? default_cache_dir() : std::filesystem::path(options.cache_dir);
   }

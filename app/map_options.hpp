@@ -1,4 +1,5 @@
-// CLI options shared by every subcommand that loads a map: --map, --cache-dir, --no-cache.
+// CLI options shared by every subcommand that loads a map: --map, --cache-dir, --no-cache,
+// --left-hand-traffic.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -13,6 +14,7 @@ struct MapOptions {
   std::string map_file;  // empty = the embedded default map
   std::string cache_dir;
   bool no_cache = false;
+  bool left_hand_traffic = false;
 };
 
 void add_map_options(CLI::App& cmd, MapOptions& options);

@@ -5,6 +5,7 @@
 #include <charconv>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include "app/cli_error.hpp"
 #include "app/map_options.hpp"
@@ -22,10 +23,11 @@ struct RouteOptions {
   MapOptions map;
   std::string from;
   std::string to;
-  double vmax_kmh = 120.0;
+  std::optional<double> vmax_kmh;  // the profile's when not given
   std::string algo = "dstar";
   double signal_delay_s = 0.0;
   double max_snap_m = 200.0;
+  std::string profile = "ambulance";
 };
 
 maps::LatLon parse_lat_lon(const std::string& text, const char* option) {
@@ -58,7 +60,7 @@ void run_route(const RouteOptions& o) {
   } else {
     throw UsageError("--algo must be dstar, astar or dijkstra, got '" + o.algo + "'");
   }
-  if (!(o.vmax_kmh > 0.0 && o.vmax_kmh <= 400.0)) throw UsageError("--vmax-kmh must be in (0, 400]");
+  if (o.vmax_kmh && !(*o.vmax_kmh > 0.0 && *o.vmax_kmh <= 400.0)) throw UsageError("--vmax-kmh must be in (0, 400]");
   if (!(o.signal_delay_s >= 0.0 && o.signal_delay_s < 3600.0)) throw UsageError("--signal-delay-s must be in [0, 3600)");
   const maps::LatLon from = parse_lat_lon(o.from, "--from");
   const maps::LatLon to = parse_lat_lon(o.to, "--to");
@@ -78,7 +80,9 @@ void run_route(const RouteOptions& o) {
 
   planner::CostOverlay overlay(graph);
   overlay.set_signal_delay(graph, o.signal_delay_s);
-  const planner::TravelCost cost(graph, overlay, {o.vmax_kmh / 3.6});
+  planner::VehicleProfile profile = planner::profile_by_name_or_file(o.profile);
+  if (o.vmax_kmh) profile.vmax_mps = *o.vmax_kmh / 3.6;
+  const planner::TravelCost cost(graph, overlay, profile);
   const auto starts = planner::points_from_snap(graph, s, planner::PointRole::start);
   const auto goals = planner::points_from_snap(graph, t, planner::PointRole::goal);
   planner::Route route;
@@ -93,6 +97,7 @@ void run_route(const RouteOptions& o) {
   if (!route.found) throw std::runtime_error("no route: the destination cannot be reached from the start");
   auto feature = planner::route_to_geojson(graph, route, planner::to_string(algo));
   feature["properties"]["snap_distance_m"] = {s.distance_m, t.distance_m};
+  feature["properties"]["profile"] = profile.name;
   std::cout << feature.dump() << '\n';
 }
 
@@ -104,7 +109,9 @@ void register_route_command(CLI::App& app) {
   add_map_options(*cmd, options->map);
   cmd->add_option("--from", options->from, "start as LAT,LON")->required();
   cmd->add_option("--to", options->to, "destination as LAT,LON")->required();
-  cmd->add_option("--vmax-kmh", options->vmax_kmh, "vehicle maximum speed in km/h")->capture_default_str();
+  cmd->add_option("--vmax-kmh", options->vmax_kmh, "vehicle maximum speed in km/h (default: the profile's)");
+  cmd->add_option("--profile", options->profile, "vehicle profile: ambulance, fire_engine, or a profile JSON file")
+      ->capture_default_str();
   cmd->add_option("--algo", options->algo, "dstar, astar or dijkstra")->capture_default_str();
   cmd->add_option("--signal-delay-s", options->signal_delay_s, "expected delay at each signalized intersection")
       ->capture_default_str();

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <optional>
 #include <random>
@@ -20,6 +21,16 @@
 
 namespace corridor::bench {
 namespace {
+
+// Resident set size of this process in MiB, from /proc/self/status (0 where it cannot be read).
+double resident_mb() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.rfind("VmRSS:", 0) == 0) return std::strtod(line.c_str() + 6, nullptr) / 1024.0;
+  }
+  return 0.0;
+}
 
 namespace beast = boost::beast;
 namespace http = beast::http;
@@ -206,7 +217,9 @@ json run_serve_bench(const maps::RoadGraph& graph, const ServeBenchConfig& c) {
   std::thread server_thread([&] { http.run(); });
   const unsigned short port = http.port();
 
-  // Missions: random origin/destination pairs; each vehicle drives along its route's polyline.
+  // Missions: random origin/destination pairs; each vehicle drives along its route's polyline. The
+  // process's resident memory before and after says what the missions' planner state costs.
+  const double rss_before_missions = resident_mb();
   std::mt19937_64 rng(c.seed);
   std::vector<std::vector<json>> tracks(static_cast<std::size_t>(c.vehicles));
   {
@@ -230,6 +243,7 @@ json run_serve_bench(const maps::RoadGraph& graph, const ServeBenchConfig& c) {
       if (track.empty()) throw std::runtime_error("bench serve: could not create mission for vehicle " + std::to_string(v));
     }
   }
+  const double rss_with_missions = resident_mb();
 
   // Load: one keep-alive connection per vehicle plus one sensor connection, all driven by
   // asynchronous I/O on a few client threads, so the load generator spends its share of the cores
@@ -310,6 +324,11 @@ json run_serve_bench(const maps::RoadGraph& graph, const ServeBenchConfig& c) {
   out["graph"] = {{"nodes", graph.node_count()}, {"edges", graph.edge_count()}};
   out["config"] = {{"vehicles", c.vehicles}, {"missions", c.missions}, {"congestion_edges_per_s", c.congestion_edges_per_s},
                    {"seconds", c.seconds}, {"rate_per_s", c.rate_per_s}, {"client_threads", c.client_threads}, {"server_threads", c.server_threads}};
+  // In-process server and load generator: the resident set is both, the mission delta the server's.
+  out["memory"] = {{"rss_mb_before_missions", rss_before_missions},
+                   {"rss_mb_with_missions", rss_with_missions},
+                   {"rss_mb_at_end", resident_mb()},
+                   {"bytes_per_mission", c.missions > 0 ? (rss_with_missions - rss_before_missions) * 1048576.0 / c.missions : 0.0}};
   out["positions"] = latency_json(all);
   out["positions"]["per_s"] = static_cast<double>(all.size()) / elapsed;
   // Paced runs only: how late the load generator itself sent, on the cores it shares with the server.

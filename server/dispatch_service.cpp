@@ -219,6 +219,14 @@ std::vector<planner::EdgePoint> DispatchService::endpoints(const maps::SnapResul
   return {points[best]};
 }
 
+// The mission's built-in profile, at its own top speed. A row stored with an unknown profile name
+// (by a later version) plans as an ambulance rather than failing the resume.
+planner::VehicleProfile DispatchService::vehicle_profile(const MissionRow& row) {
+  planner::VehicleProfile p = row.profile == "fire_engine" ? planner::fire_engine_profile() : planner::ambulance_profile();
+  p.vmax_mps = row.vmax_kmh / 3.6;
+  return p;
+}
+
 MissionView DispatchService::view(const Mission& m) const {
   MissionView v;
   v.id = m.row.id;
@@ -226,6 +234,7 @@ MissionView DispatchService::view(const Mission& m) const {
   v.state = m.row.state;
   v.priority = m.row.priority;
   v.vmax_kmh = m.row.vmax_kmh;
+  v.profile = m.row.profile;
   v.destination = m.row.destination;
   v.last_position = m.last_position;
   v.route = m.route;
@@ -358,10 +367,11 @@ MissionView DispatchService::create_mission(const MissionRequest& req, double no
 
   auto m = std::make_shared<Mission>();
   std::unique_lock mission_lock(m->mutex);
-  m->row = {next_mission_id_, req.vehicle_id, req.priority, req.vmax_kmh, req.destination, origin, MissionState::active, now_s, now_s};
+  m->row = {next_mission_id_, req.vehicle_id, req.priority, req.vmax_kmh, req.destination, origin, MissionState::active, now_s, now_s,
+            req.profile};
   m->last_position = origin;
   m->destination_local = to.point;
-  m->cost = std::make_unique<planner::TravelCost>(graph_, overlay_, planner::VehicleProfile{req.vmax_kmh / 3.6});
+  m->cost = std::make_unique<planner::TravelCost>(graph_, overlay_, vehicle_profile(m->row));
   Staged staged;
   {
     // Planned and registered under one view of the costs, so no congestion change falls between.
@@ -639,7 +649,7 @@ void DispatchService::restore(double now_s) {
       m->row = row;
       m->last_position = start;
       m->destination_local = to.point;
-      m->cost = std::make_unique<planner::TravelCost>(graph_, overlay_, planner::VehicleProfile{row.vmax_kmh / 3.6});
+      m->cost = std::make_unique<planner::TravelCost>(graph_, overlay_, vehicle_profile(row));
       m->planner = std::make_unique<planner::DStarLite>(
           *m->cost, endpoints(from, Role::start, last ? last->heading_deg : std::nullopt),
           endpoints(to, Role::goal, std::nullopt));

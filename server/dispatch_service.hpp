@@ -120,6 +120,7 @@ class DispatchService {
   void announce_signal_state(NodeId node, double now_s);
   [[nodiscard]] std::string signal_state_locked(NodeId node) const;
   MissionView view(const Mission& m) const;
+  static planner::VehicleProfile vehicle_profile(const MissionRow& row);
   // Ends a mission in memory; the caller stores the new state (stage_state) first.
   void finish(Mission& m, MissionState state, double now_s, Staged& staged);
   void stage_state(const Mission& m, MissionState state, double now_s, Staged& staged) const;

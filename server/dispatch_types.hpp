@@ -28,6 +28,7 @@ struct MissionRequest {
   std::optional<maps::LatLon> origin;  // else the vehicle's last known position
   int priority = 1;
   double vmax_kmh = 120.0;
+  std::string profile = "ambulance";  // a built-in vehicle profile: ambulance or fire_engine
 };
 
 struct PositionReport {
@@ -55,6 +56,7 @@ struct MissionView {
   MissionState state = MissionState::active;
   int priority = 1;
   double vmax_kmh = 120.0;
+  std::string profile = "ambulance";
   maps::LatLon destination;
   std::optional<maps::LatLon> last_position;
   planner::Route route;

@@ -77,6 +77,14 @@ MissionRequest mission_request_from_json(const json& j) {
     }
     r.priority = static_cast<int>(it->get<std::int64_t>());
   }
+  if (auto it = j.find("profile"); it != j.end()) {
+    // Built-in names only: a client does not get to name files on the server.
+    if (!it->is_string() || (*it != "ambulance" && *it != "fire_engine")) {
+      throw bad_request("field 'profile' must be \"ambulance\" or \"fire_engine\"");
+    }
+    r.profile = it->get<std::string>();
+    r.vmax_kmh = planner::builtin_profile(r.profile).vmax_mps * 3.6;
+  }
   if (auto v = optional_number(j, "vmax_kmh")) r.vmax_kmh = *v;
   return r;
 }
@@ -158,6 +166,7 @@ json mission_to_json(const maps::RoadGraph& graph, const MissionView& m) {
          {"state", to_string(m.state)},
          {"priority", m.priority},
          {"vmax_kmh", m.vmax_kmh},
+         {"profile", m.profile},
          {"destination", ll(m.destination)},
          {"route_revision", m.route_revision},
          {"created_s", m.created_s},

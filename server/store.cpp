@@ -18,7 +18,7 @@ namespace corridor::server {
 namespace {
 
 // Each entry moves the schema one version up; never edit a released entry, append a new one.
-constexpr std::array<const char*, 3> kMigrations{
+constexpr std::array<const char*, 4> kMigrations{
     R"sql(
     CREATE TABLE missions (
       id INTEGER PRIMARY KEY AUTOINCREMENT,
@@ -83,6 +83,10 @@ constexpr std::array<const char*, 3> kMigrations{
     ALTER TABLE positions ADD COLUMN edge INTEGER;
     ALTER TABLE positions ADD COLUMN offset_m REAL;
     ALTER TABLE positions ADD COLUMN match_confidence REAL;
+    )sql",
+    // v4: the vehicle profile a mission plans with (missions stored before it were ambulances).
+    R"sql(
+    ALTER TABLE missions ADD COLUMN profile TEXT NOT NULL DEFAULT 'ambulance';
     )sql",
 };
 
@@ -345,12 +349,12 @@ void Store::Transaction::commit() {
 
 void Store::insert_mission(const MissionRow& r) {
   Statement s(cached("INSERT INTO missions(id, vehicle_id, priority, vmax_kmh, dest_lat, dest_lon, origin_lat, origin_lon, "
-                     "state, created_s, updated_s) VALUES (?,?,?,?,?,?,?,?,?,?,?)"));
+                     "state, created_s, updated_s, profile) VALUES (?,?,?,?,?,?,?,?,?,?,?,?)"));
   s.bind(1, static_cast<std::int64_t>(r.id)).bind(2, r.vehicle_id).bind(3, static_cast<std::int64_t>(r.priority));
   s.bind(4, r.vmax_kmh).bind(5, r.destination.lat_deg).bind(6, r.destination.lon_deg);
   s.bind(7, r.origin ? std::optional<double>(r.origin->lat_deg) : std::nullopt);
   s.bind(8, r.origin ? std::optional<double>(r.origin->lon_deg) : std::nullopt);
-  s.bind(9, std::string(to_string(r.state))).bind(10, r.created_s).bind(11, r.updated_s);
+  s.bind(9, std::string(to_string(r.state))).bind(10, r.created_s).bind(11, r.updated_s).bind(12, r.profile);
   s.step();
 }
 
@@ -400,9 +404,9 @@ void Store::insert_preemption_event(const preemption::PreemptionEvent& e) {
 
 std::vector<MissionRow> Store::missions(std::optional<MissionState> state) const {
   Statement s(db_, state ? "SELECT id, vehicle_id, priority, vmax_kmh, dest_lat, dest_lon, origin_lat, origin_lon, state, "
-                           "created_s, updated_s FROM missions WHERE state = ? ORDER BY id"
+                           "created_s, updated_s, profile FROM missions WHERE state = ? ORDER BY id"
                          : "SELECT id, vehicle_id, priority, vmax_kmh, dest_lat, dest_lon, origin_lat, origin_lon, state, "
-                           "created_s, updated_s FROM missions ORDER BY id");
+                           "created_s, updated_s, profile FROM missions ORDER BY id");
   if (state) s.bind(1, std::string(to_string(*state)));
   std::vector<MissionRow> out;
   while (s.step()) {
@@ -416,6 +420,7 @@ std::vector<MissionRow> Store::missions(std::optional<MissionState> state) const
     r.state = mission_state_from(s.text(8)).value_or(MissionState::cancelled);
     r.created_s = s.real(9);
     r.updated_s = s.real(10);
+    r.profile = s.text(11);
     out.push_back(std::move(r));
   }
   return out;

@@ -37,6 +37,7 @@ struct MissionRow {
   MissionState state = MissionState::active;
   double created_s = 0;
   double updated_s = 0;
+  std::string profile = "ambulance";  // a built-in vehicle profile (planner/vehicle_profile.hpp)
 };
 
 struct PositionRow {

@@ -360,7 +360,7 @@ TEST(DispatchService, PersistsAndResumesActiveMissionsAfterRestart) {
     EXPECT_GT(store.count("preemption_events"), 0u);
   }  // the process "dies" here: nothing is flushed beyond what each call committed
   Store store(db.path());
-  EXPECT_EQ(store.schema_version(), 3);
+  EXPECT_EQ(store.schema_version(), 4);
   DispatchService service(grid(), {}, &store, 10.0);
   EXPECT_EQ(service.active_mission_count(), 1u);
   const MissionView resumed = service.mission(kept);
@@ -392,6 +392,11 @@ TEST(Store, MigratesVersion1PositionsToEachVehiclesLatest) {
   p.vehicle_id = "amb-a";
   {
     Store store(db.path());
+    MissionRow m;
+    m.id = 7;
+    m.vehicle_id = "amb-a";
+    m.destination = {43.74, 7.43};
+    store.insert_mission(m);
     for (int i = 0; i < 3; ++i) {
       p.position = {43.73 + 0.001 * i, 7.42};
       p.timestamp_s = i;
@@ -408,12 +413,13 @@ TEST(Store, MigratesVersion1PositionsToEachVehiclesLatest) {
                          "DROP TABLE vehicle_last_position; CREATE INDEX positions_vehicle ON positions(vehicle_id, id);"
                          "ALTER TABLE positions DROP COLUMN disposition; ALTER TABLE positions DROP COLUMN edge;"
                          "ALTER TABLE positions DROP COLUMN offset_m; ALTER TABLE positions DROP COLUMN match_confidence;"
+                         "ALTER TABLE missions DROP COLUMN profile;"
                          "DELETE FROM schema_migrations WHERE version >= 2;",
                          nullptr, nullptr, nullptr),
             SQLITE_OK);
   sqlite3_close(raw);
   Store store(db.path());
-  EXPECT_EQ(store.schema_version(), 3);
+  EXPECT_EQ(store.schema_version(), 4);
   const auto a = store.last_position("amb-a");
   ASSERT_TRUE(a.has_value());
   EXPECT_DOUBLE_EQ(a->position.lat_deg, 43.732);
@@ -427,6 +433,44 @@ TEST(Store, MigratesVersion1PositionsToEachVehiclesLatest) {
   store.insert_position(p, std::nullopt, 6.0);
   EXPECT_DOUBLE_EQ(store.last_position("amb-b")->position.lat_deg, 43.71);
   EXPECT_EQ(store.count("positions"), 5u);
+  // The mission stored before profiles existed is an ambulance's.
+  ASSERT_EQ(store.missions(std::nullopt).size(), 1u);
+  EXPECT_EQ(store.missions(std::nullopt).front().profile, "ambulance");
+}
+
+// A fire engine's mission plans with the fire engine's profile (a 3.5 m, 15 t truck that the
+// ambulance's turn costs and limits do not describe), and keeps it across a restart. Missions
+// stored before profiles existed (schema v3) resume as ambulances.
+TEST(DispatchService, MissionKeepsItsVehicleProfileAcrossARestart) {
+  TempDb db;
+  MissionId fire = 0;
+  {
+    Store store(db.path());
+    DispatchService service(grid(), {}, &store, 0.0);
+    MissionRequest r = request("engine-1");
+    r.profile = "fire_engine";
+    r.vmax_kmh = 80.0;
+    const MissionView m = service.create_mission(r, 0.0);
+    fire = m.id;
+    EXPECT_EQ(m.profile, "fire_engine");
+    (void)service.create_mission(request("amb-1"), 0.0);
+    // The route is the fire engine's: Dijkstra with that profile gives the same cost.
+    planner::CostOverlay overlay(grid());
+    overlay.set_signal_delay(grid(), DispatchConfig{}.signal_delay_s);
+    preemption::set_signal_costs(overlay, maps::default_signal_plans(grid()), preemption::SignalCostRule::preempted);
+    planner::VehicleProfile p = planner::fire_engine_profile();
+    p.vmax_mps = 80.0 / 3.6;
+    const planner::TravelCost cost(grid(), overlay, p);
+    planner::OneToOneSearch dijkstra;
+    const auto oracle = dijkstra.run(planner::SearchSpace(cost, {m.route.start}, {m.route.goal}), false);
+    EXPECT_NEAR(oracle.travel_time_s, m.route.travel_time_s, 1e-6);
+  }
+  {
+    Store store(db.path());
+    DispatchService service(grid(), {}, &store, 10.0);
+    EXPECT_EQ(service.mission(fire).profile, "fire_engine");
+    EXPECT_EQ(service.mission(fire).vmax_kmh, 80.0);
+  }
 }
 
 TEST(Store, RefusesADatabaseFromANewerBuild) {
@@ -434,7 +478,7 @@ TEST(Store, RefusesADatabaseFromANewerBuild) {
   { Store store(db.path()); }
   {
     Store store(db.path());  // reopening an up-to-date database is fine
-    EXPECT_EQ(store.schema_version(), 3);
+    EXPECT_EQ(store.schema_version(), 4);
   }
   sqlite3* raw = nullptr;
   ASSERT_EQ(sqlite3_open(db.path().c_str(), &raw), SQLITE_OK);

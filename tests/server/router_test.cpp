@@ -64,6 +64,15 @@ TEST(Router, CreateReadListCancelMission) {
   EXPECT_EQ(rig.call("POST", "/v1/missions/" + id + "/cancel", kDispatcher).status, 200);
   EXPECT_EQ(body(rig.call("GET", "/v1/missions/" + id, kViewer))["state"], "cancelled");
   EXPECT_EQ(rig.call("POST", "/v1/missions/" + id + "/cancel", kDispatcher).status, 409);
+  EXPECT_EQ(m["profile"], "ambulance");
+  EXPECT_EQ(m["vmax_kmh"], 120.0);
+  // A fire engine: its own profile, and its top speed unless the request gives one.
+  std::string fire = mission_body("engine-1");
+  fire.insert(fire.size() - 1, ",\"profile\":\"fire_engine\"");
+  const auto engine = rig.call("POST", "/v1/missions", kDispatcher, fire);
+  ASSERT_EQ(engine.status, 201) << engine.body;
+  EXPECT_EQ(body(engine)["profile"], "fire_engine");
+  EXPECT_EQ(body(engine)["vmax_kmh"], 90.0);
 }
 
 TEST(Router, AuthenticationAndRoles) {
@@ -100,6 +109,9 @@ TEST(Router, BadInputsGetClearFourHundreds) {
       {"{\"vehicle_id\":\"a\",\"destination\":{\"lat\":1e400,\"lon\":1}}", 400},
       {"{\"vehicle_id\":\"a\",\"destination\":{\"lat\":10,\"lon\":10},\"origin\":{\"lat\":10,\"lon\":10}}", 422},
       {"{\"vehicle_id\":\"a\",\"destination\":{\"lat\":10,\"lon\":10},\"priority\":1.5}", 400},
+      {"{\"vehicle_id\":\"a\",\"destination\":{\"lat\":10,\"lon\":10},\"profile\":\"tank\"}", 400},
+      {"{\"vehicle_id\":\"a\",\"destination\":{\"lat\":10,\"lon\":10},\"profile\":\"/etc/passwd\"}", 400},
+      {"{\"vehicle_id\":\"a\",\"destination\":{\"lat\":10,\"lon\":10},\"profile\":7}", 400},
   };
   for (const auto& [text, status] : cases) {
     const auto r = rig.call("POST", "/v1/missions", kDispatcher, text);

@@ -145,6 +145,7 @@ describe('dispatch console (Monaco)', () => {
     // ...and a click on the map moves it.
     await page.getByTestId('vehicle-input').fill('amb-1');
     await page.getByTestId('priority-input').fill('3');
+    await page.getByTestId('profile-input').selectOption('fire_engine');
     await zoomAt(page, DESTINATION.lat, DESTINATION.lon, 0);
     const p = await stablePoint(page, DESTINATION.lat, DESTINATION.lon);
     await page.mouse.click(p.x, p.y);
@@ -160,6 +161,7 @@ describe('dispatch console (Monaco)', () => {
     mission = (await api(server.url, 'GET', `/v1/missions/${missionId}`)).json;
     assert.equal(mission.vehicle_id, 'amb-1');
     assert.equal(mission.priority, 3);
+    assert.equal(mission.profile, 'fire_engine');
     assert.ok(mission.route, 'the mission has a route');
     assert.ok(mission.preemption.length > 0, 'the route crosses signals');
     await waitFor('the route in the page', () =>

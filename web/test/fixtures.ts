@@ -46,6 +46,7 @@ export function mission(id: number, over: Partial<Mission> = {}): Mission {
     state: 'active',
     priority: 2,
     vmax_kmh: 120,
+    profile: 'ambulance',
     destination: { lat: 43.7496, lon: 7.4365 },
     route_revision: 1,
     created_s: T0,

@@ -1739,6 +1739,11 @@ export interface components {
             state: "active" | "completed" | "cancelled";
             priority: number;
             vmax_kmh: number;
+            /**
+             * @description The vehicle profile the route is planned with: turn rules, turn costs, dimensions
+             * @enum {string}
+             */
+            profile: "ambulance" | "fire_engine";
             destination: components["schemas"]["LatLon"];
             route_revision: number;
             created_s: number;
@@ -1756,7 +1761,13 @@ export interface components {
             destination: components["schemas"]["LatLon"];
             origin?: components["schemas"]["LatLon"];
             priority?: number;
+            /** @description Default: the profile's top speed (ambulance 120, fire_engine 90) */
             vmax_kmh?: number;
+            /**
+             * @description The vehicle profile to plan with; ambulance when absent
+             * @enum {string}
+             */
+            profile?: "ambulance" | "fire_engine";
         };
         RouteRevision: {
             revision: number;

@@ -1,6 +1,6 @@
 // Dispatch form (dispatcher role): destination by a click on the map or a street name, vehicle
-// from the known vehicles or typed, priority 0-10, optional origin by a second click; creates the
-// mission with POST /v1/missions.
+// from the known vehicles or typed, priority 0-10, the vehicle type (its routing profile), optional
+// origin by a second click; creates the mission with POST /v1/missions.
 import L from 'leaflet';
 import type { ApiClient } from '../api/client';
 import { ApiError } from '../api/client';
@@ -124,6 +124,7 @@ export class DispatchPanel {
     const error = byTestId('dispatch-error');
     const vehicle = byTestId<HTMLInputElement>('vehicle-input').value.trim();
     const priority = Number(byTestId<HTMLInputElement>('priority-input').value);
+    const profile = byTestId<HTMLSelectElement>('profile-input').value === 'fire_engine' ? 'fire_engine' : 'ambulance';
     if (!this.destination) {
       error.textContent = 'Click the map (or search a street) to set the destination.';
       return;
@@ -144,6 +145,7 @@ export class DispatchPanel {
         vehicle_id: vehicle,
         destination: this.destination,
         priority,
+        profile,
         ...(this.origin ? { origin: this.origin } : {}),
       });
       this.store.dispatch({ type: 'missions', missions: [m], nowMs: Date.now() });

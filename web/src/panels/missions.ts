@@ -120,7 +120,7 @@ export class MissionPanel {
 
   private summary(m: Mission, state: State, nowMs: number): string {
     const length = m.route ? fmtDistance(m.route.properties.length_m) : 'no route';
-    return `${m.vehicle_id} · priority ${m.priority} · ${m.state} · ETA ${etaLabel(m, nowMs, state.clockOffsetMs)} · ${length} · revision ${m.route_revision}`;
+    return `${m.vehicle_id} · ${m.profile === 'fire_engine' ? 'fire engine' : 'ambulance'} · priority ${m.priority} · ${m.state} · ETA ${etaLabel(m, nowMs, state.clockOffsetMs)} · ${length} · revision ${m.route_revision}`;
   }
 
   private renderDetail(state: State, nowMs: number): void {
