@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <numeric>
 #include <chrono>
 #include <cmath>
 #include <random>
@@ -159,6 +160,7 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
   res.landmarks = graph.landmark_count();
   res.edges = graph.edge_count();
   std::vector<double> t_dstar, t_astar, t_dijkstra, t_dstar0, t_astar0;
+  std::vector<double> planner_bytes;
   double expanded = 0, rekeyed = 0, raised = 0, astar_settled = 0, dijkstra_settled = 0;
   planner::OneToOneSearch astar, dijkstra;
   std::uniform_int_distribution<std::uint32_t> any_edge(0, static_cast<std::uint32_t>(graph.edge_count() - 1));
@@ -240,6 +242,7 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
       if (!std::equal(from, route.edges.end(), next.edges.begin(), next.edges.end())) ++res.route_changes;
       route = std::move(next);
     }
+    planner_bytes.push_back(static_cast<double>(dstar.memory_bytes()));
     progress.update(trip + 1);
   }
   progress.finish();
@@ -251,6 +254,10 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
   res.astar_initial = summarize_ms(t_astar0);
   const double n = res.replans > 0 ? static_cast<double>(res.replans) : 1.0;
   res.dstar_mean_expanded = expanded / n;
+  // A trip's planner at its end: what a mission that drove that trip holds.
+  res.dstar_bytes_per_planner = planner_bytes.empty() ? 0.0 : std::accumulate(planner_bytes.begin(), planner_bytes.end(), 0.0) /
+                                                                  static_cast<double>(planner_bytes.size());
+  res.dstar_max_bytes_per_planner = planner_bytes.empty() ? 0.0 : *std::max_element(planner_bytes.begin(), planner_bytes.end());
   res.dstar_mean_rekeyed = rekeyed / n;
   res.dstar_mean_raised = raised / n;
   res.astar_mean_settled = astar_settled / n;
@@ -279,6 +286,8 @@ nlohmann::json to_json(const ReplanBenchResult& r, const ReplanBenchConfig& c) {
   j["route_changes"] = r.route_changes;
   j["dstar"] = to_json(r.dstar);
   j["dstar"]["mean_expanded"] = r.dstar_mean_expanded;
+  j["dstar"]["mean_bytes_per_planner"] = r.dstar_bytes_per_planner;
+  j["dstar"]["max_bytes_per_planner"] = r.dstar_max_bytes_per_planner;
   // Replans that end with the goal cut off must visit everything the start (Dijkstra, A*) or the
   // old search tree (D* Lite) reaches to prove it; shown apart so they do not hide the rest.
   std::vector<double> dstar_ok, astar_ok;

@@ -68,6 +68,8 @@ struct ReplanBenchResult {
   LatencySummary dstar, astar, dijkstra;
   LatencySummary dstar_initial, astar_initial;
   double dstar_mean_expanded = 0;
+  double dstar_bytes_per_planner = 0;      // mean over trips, at the trip's end (DStarLite::memory_bytes)
+  double dstar_max_bytes_per_planner = 0;
   double dstar_mean_rekeyed = 0;
   double dstar_mean_raised = 0;
   double astar_mean_settled = 0;

@@ -7,28 +7,28 @@ namespace corridor::planner {
 
 DStarLite::DStarLite(const TravelCost& cost, std::vector<EdgePoint> starts, std::vector<EdgePoint> goals)
     : space_(cost, std::move(starts), std::move(goals)),
-      g_(space_.vertex_count(), kInfCost),
-      rhs_(space_.vertex_count(), kInfCost),
-      open_(space_.vertex_count()) {
+      states_(std::make_unique<PagedVertexStates>(space_.vertex_count())),
+      open_(PagedVertexStates::HeapPositions(states_.get())) {
   // Initialize(): the search runs backward, so it starts at the goal. (Koenig & Likhachev Fig. 4)
   const Vertex goal = space_.goal();
-  rhs_[goal.index()] = 0.0;
+  states_->at(goal.v).rhs = 0.0;
   open_.push_or_update(goal.v, calculate_key(goal));
 }
 
 DStarLite::Key DStarLite::calculate_key(Vertex s) const {
-  const double m = std::min(g_[s.index()], rhs_[s.index()]);
+  const VertexState& st = states_->get(s.v);
+  const double m = std::min(st.g, st.rhs);
   return {add_cost(add_cost(m, space_.h_from_start_s(s)), km_), m};
 }
 
 double DStarLite::min_successor_cost(Vertex u) const {
   double best = kInfCost;
-  space_.for_each_successor(u, [&](Vertex v, double c, EdgeId) { best = std::min(best, add_cost(c, g_[v.index()])); });
+  space_.for_each_successor(u, [&](Vertex v, double c, EdgeId) { best = std::min(best, add_cost(c, g(v))); });
   return best;
 }
 
 void DStarLite::update_vertex(Vertex u) {
-  if (g_[u.index()] != rhs_[u.index()]) {
+  if (g(u) != rhs(u)) {
     open_.push_or_update(u.v, calculate_key(u));
   } else {
     open_.remove(u.v);
@@ -37,7 +37,9 @@ void DStarLite::update_vertex(Vertex u) {
 
 void DStarLite::recompute_rhs(Vertex u) {
   if (u == space_.goal()) return;
-  rhs_[u.index()] = min_successor_cost(u);
+  const double best = min_successor_cost(u);
+  // An untouched vertex whose rhs stays infinite keeps its page unallocated.
+  if (best != rhs(u)) states_->at(u.v).rhs = best;
   update_vertex(u);
 }
 
@@ -77,7 +79,7 @@ ReplanStats DStarLite::replan() {
   auto must_continue = [&] {
     const Key ks = calculate_key(start);
     const double slack = 1e-9 * std::max(1.0, std::abs(ks.k1));
-    return open_.top_key().k1 <= ks.k1 + slack || rhs_[start.index()] > g_[start.index()];
+    return open_.top_key().k1 <= ks.k1 + slack || rhs(start) > g(start);
   };
   // A start whose every arc is closed reaches nothing, and a goal whose every arc is closed is
   // reached from nowhere, whatever the g values. The loop would settle the whole old search tree to
@@ -97,16 +99,17 @@ ReplanStats DStarLite::replan() {
     if (k_old < k_new) {
       ++stats.rekeyed;
       open_.push_or_update(u.v, k_new);
-    } else if (g_[u.index()] > rhs_[u.index()]) {
+    } else if (g(u) > rhs(u)) {
       // Overconsistent: settle u and relax its predecessors.
-      g_[u.index()] = rhs_[u.index()];
+      VertexState& su = states_->at(u.v);
+      su.g = su.rhs;
+      const double gu = su.g;
       open_.remove(u.v);
-      const double gu = g_[u.index()];
       space_.for_each_predecessor(u, [&](Vertex s, double c) {
         if (s == goal) return;
         const double via_u = add_cost(c, gu);
-        if (via_u < rhs_[s.index()]) {
-          rhs_[s.index()] = via_u;
+        if (via_u < rhs(s)) {
+          states_->at(s.v).rhs = via_u;
           update_vertex(s);
           ++stats.updated;
         }
@@ -114,13 +117,13 @@ ReplanStats DStarLite::replan() {
     } else {
       // Underconsistent: u's old value may have supported its predecessors; re-derive them.
       ++stats.underconsistent;
-      const double g_old = g_[u.index()];
-      g_[u.index()] = kInfCost;
+      const double g_old = g(u);
+      states_->at(u.v).g = kInfCost;
       space_.for_each_predecessor(u, [&](Vertex s, double c) {
         // Only a predecessor that u supported changes. The others keep g, rhs and so their place
         // in (or out of) the queue; a key left stale is a lower bound, which the rekey step handles.
-        if (s != goal && rhs_[s.index()] == add_cost(c, g_old)) {
-          rhs_[s.index()] = min_successor_cost(s);
+        if (s != goal && rhs(s) == add_cost(c, g_old)) {
+          states_->at(s.v).rhs = min_successor_cost(s);
           ++stats.updated;
           update_vertex(s);
         }
@@ -136,16 +139,21 @@ std::string DStarLite::invariant_violation() const {
   for (std::uint32_t i = 0; i < space_.vertex_count(); ++i) {
     const Vertex u{i};
     const double expected_rhs = u == space_.goal() ? 0.0 : min_successor_cost(u);
-    if (expected_rhs != rhs_[i]) {
-      return "vertex " + std::to_string(i) + ": rhs " + std::to_string(rhs_[i]) + " but successors give " +
+    if (expected_rhs != rhs(u)) {
+      return "vertex " + std::to_string(i) + ": rhs " + std::to_string(rhs(u)) + " but successors give " +
              std::to_string(expected_rhs);
     }
-    if ((g_[i] != rhs_[i]) != open_.contains(i)) {
+    if ((g(u) != rhs(u)) != open_.contains(i)) {
       return "vertex " + std::to_string(i) + ": queued=" + std::to_string(open_.contains(i)) + " g=" +
-             std::to_string(g_[i]) + " rhs=" + std::to_string(rhs_[i]);
+             std::to_string(g(u)) + " rhs=" + std::to_string(rhs(u));
     }
   }
   return {};
+}
+
+std::size_t DStarLite::memory_bytes() const {
+  return sizeof(*this) + states_->bytes() + open_.capacity_bytes() +
+         (space_.starts().size() + space_.goals().size()) * sizeof(EdgePoint);
 }
 
 Route DStarLite::route() const {
@@ -160,7 +168,7 @@ Route DStarLite::route() const {
     Vertex next;
     EdgeId via;
     space_.for_each_successor(u, [&](Vertex v, double c, EdgeId e) {
-      const double total = add_cost(c, v == goal ? 0.0 : g_[v.index()]);
+      const double total = add_cost(c, v == goal ? 0.0 : g(v));
       if (total < best) {
         best = total;
         next = v;

@@ -3,12 +3,14 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
 
 #include "planner/indexed_heap.hpp"
 #include "planner/one_to_one_search.hpp"
+#include "planner/paged_vertex_state.hpp"
 #include "planner/route.hpp"
 #include "planner/search_space.hpp"
 
@@ -37,11 +39,14 @@ class DStarLite {
 
   // Cost from the vehicle to the goal (kInfCost when unreachable); valid after replan().
   // rhs, not g: S has no predecessors, so the search may stop with S overconsistent.
-  [[nodiscard]] double cost_to_goal_s() const { return cut_off_ ? kInfCost : rhs_[space_.start().index()]; }
+  [[nodiscard]] double cost_to_goal_s() const { return cut_off_ ? kInfCost : rhs(space_.start()); }
   // The current route, extracted greedily from the g values; valid after replan().
   [[nodiscard]] Route route() const;
 
   [[nodiscard]] const SearchSpace& space() const { return space_; }
+  // What this planner holds: its vertex pages, open list and start points. It grows with the part
+  // of the graph the searches touched, not with the graph.
+  [[nodiscard]] std::size_t memory_bytes() const;
 
   // Checks D* Lite's invariants over every vertex: rhs(u) = min over successors of c + g, and a
   // vertex is queued exactly when it is inconsistent. O(V + E); for tests. Empty when all hold.
@@ -59,10 +64,12 @@ class DStarLite {
   void update_vertex(Vertex u);
   void recompute_rhs(Vertex u);
 
+  [[nodiscard]] double g(Vertex v) const { return states_->get(v.v).g; }
+  [[nodiscard]] double rhs(Vertex v) const { return states_->get(v.v).rhs; }
+
   SearchSpace space_;
-  std::vector<double> g_;
-  std::vector<double> rhs_;
-  IndexedHeap<Key> open_;
+  std::unique_ptr<PagedVertexStates> states_;  // on the heap: the open list points into it
+  IndexedHeap<Key, PagedVertexStates::HeapPositions> open_;
   double km_ = 0.0;
   std::vector<NodeId> old_heads_;  // move_start's scratch: the heads before the move
   bool cut_off_ = false;  // every arc out of S or into G is closed: no route, repair deferred

@@ -1,6 +1,8 @@
-// A 4-ary min-heap over dense vertex ids with decrease-, increase-key and removal, as D* Lite's
-// open list needs. Keys are compared with operator<. Four children per node: a shallower heap, and
-// the children of one node share a cache line or two.
+// A 4-ary min-heap over vertex ids with decrease-, increase-key and removal, as D* Lite's open list
+// needs. Keys are compared with operator<. Four children per node: a shallower heap, and the
+// children of one node share a cache line or two. Where each id sits in the heap is kept by a
+// Positions store: a dense array by default, or the caller's own (D* Lite keeps it in its paged
+// per-vertex state).
 #pragma once
 
 #include <cstdint>
@@ -10,28 +12,42 @@
 
 namespace corridor::planner {
 
-template <class Key>
+inline constexpr std::uint32_t kHeapAbsent = std::numeric_limits<std::uint32_t>::max();
+
+// One position per id in a dense array.
+class DenseHeapPositions {
+ public:
+  explicit DenseHeapPositions(std::size_t id_count = 0) : pos_(id_count, kHeapAbsent) {}
+  [[nodiscard]] std::uint32_t get(std::uint32_t id) const { return pos_[id]; }
+  void set(std::uint32_t id, std::uint32_t i) { pos_[id] = i; }
+
+ private:
+  std::vector<std::uint32_t> pos_;
+};
+
+template <class Key, class Positions = DenseHeapPositions>
 class IndexedHeap {
  public:
-  static constexpr std::uint32_t kAbsent = std::numeric_limits<std::uint32_t>::max();
+  static constexpr std::uint32_t kAbsent = kHeapAbsent;
 
-  explicit IndexedHeap(std::size_t id_count = 0) : pos_(id_count, kAbsent) {}
+  explicit IndexedHeap(std::size_t id_count = 0) : pos_(id_count) {}
+  explicit IndexedHeap(Positions positions) : pos_(std::move(positions)) {}
 
   [[nodiscard]] bool empty() const { return heap_.empty(); }
   [[nodiscard]] std::size_t size() const { return heap_.size(); }
-  [[nodiscard]] bool contains(std::uint32_t id) const { return pos_[id] != kAbsent; }
+  [[nodiscard]] std::size_t capacity_bytes() const { return heap_.capacity() * sizeof(Entry); }
+  [[nodiscard]] bool contains(std::uint32_t id) const { return pos_.get(id) != kAbsent; }
   [[nodiscard]] const Key& top_key() const { return heap_.front().key; }
   [[nodiscard]] std::uint32_t top() const { return heap_.front().id; }
 
   // Inserts, or changes the key of an id already present.
   void push_or_update(std::uint32_t id, const Key& key) {
-    if (pos_[id] == kAbsent) {
-      pos_[id] = static_cast<std::uint32_t>(heap_.size());
+    const std::uint32_t i = pos_.get(id);
+    if (i == kAbsent) {
       heap_.push_back({key, id});
-      sift_up(pos_[id]);
+      sift_up(static_cast<std::uint32_t>(heap_.size() - 1));
       return;
     }
-    const std::uint32_t i = pos_[id];
     const bool decreased = key < heap_[i].key;
     heap_[i].key = key;
     if (decreased) {
@@ -42,24 +58,27 @@ class IndexedHeap {
   }
 
   void remove(std::uint32_t id) {
-    const std::uint32_t i = pos_[id];
+    const std::uint32_t i = pos_.get(id);
     if (i == kAbsent) return;
-    pos_[id] = kAbsent;
+    pos_.set(id, kAbsent);
     if (i + 1 == heap_.size()) {
       heap_.pop_back();
       return;
     }
     heap_[i] = heap_.back();
     heap_.pop_back();
-    pos_[heap_[i].id] = i;
+    pos_.set(heap_[i].id, i);
     sift_down(i);
-    sift_up(pos_[heap_[i].id] == i ? i : pos_[heap_[i].id]);
+    sift_up(pos_.get(heap_[i].id) == i ? i : pos_.get(heap_[i].id));
   }
 
   void clear() {
-    for (const auto& entry : heap_) pos_[entry.id] = kAbsent;
+    for (const auto& entry : heap_) pos_.set(entry.id, kAbsent);
     heap_.clear();
   }
+
+  [[nodiscard]] Positions& positions() { return pos_; }
+  [[nodiscard]] const Positions& positions() const { return pos_; }
 
  private:
   static constexpr std::uint32_t kArity = 4;
@@ -70,7 +89,7 @@ class IndexedHeap {
   };
 
   void place(std::uint32_t i, Entry e) {
-    pos_[e.id] = i;
+    pos_.set(e.id, i);
     heap_[i] = std::move(e);
   }
   void sift_up(std::uint32_t i) {
@@ -102,7 +121,7 @@ class IndexedHeap {
   }
 
   std::vector<Entry> heap_;
-  std::vector<std::uint32_t> pos_;
+  Positions pos_;
 };
 
 }  // namespace corridor::planner

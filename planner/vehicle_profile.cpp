@@ -1,6 +1,8 @@
 #include "planner/vehicle_profile.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -17,6 +19,16 @@ constexpr std::pair<std::string_view, RestrictionMode> kModes[] = {
     {"vehicle", RestrictionMode::vehicle},
     {"emergency", RestrictionMode::emergency},
     {"hgv", RestrictionMode::hgv},
+};
+
+// The plain numeric fields, by their JSON key.
+constexpr std::pair<const char*, double VehicleProfile::*> kNumbers[] = {
+    {"height_m", &VehicleProfile::height_m},
+    {"width_m", &VehicleProfile::width_m},
+    {"weight_t", &VehicleProfile::weight_t},
+    {"turn_penalty_s", &VehicleProfile::turn_penalty_s},
+    {"crossing_penalty_s", &VehicleProfile::crossing_penalty_s},
+    {"uturn_penalty_s", &VehicleProfile::uturn_penalty_s},
 };
 
 void require(bool ok, const std::string& what) {
@@ -92,18 +104,9 @@ VehicleProfile profile_from_json(std::string_view text) {
       p.name = value.get<std::string>();
     } else if (key == "vmax_kmh") {
       p.vmax_mps = number(value, "vmax_kmh") / 3.6;
-    } else if (key == "height_m") {
-      p.height_m = number(value, "height_m");
-    } else if (key == "width_m") {
-      p.width_m = number(value, "width_m");
-    } else if (key == "weight_t") {
-      p.weight_t = number(value, "weight_t");
-    } else if (key == "turn_penalty_s") {
-      p.turn_penalty_s = number(value, "turn_penalty_s");
-    } else if (key == "crossing_penalty_s") {
-      p.crossing_penalty_s = number(value, "crossing_penalty_s");
-    } else if (key == "uturn_penalty_s") {
-      p.uturn_penalty_s = number(value, "uturn_penalty_s");
+    } else if (const auto field = std::find_if(std::begin(kNumbers), std::end(kNumbers), [&](const auto& f) { return key == f.first; });
+               field != std::end(kNumbers)) {
+      p.*(field->second) = number(value, field->first);
     } else if (key == "emergency_exceptions") {
       require(value.is_boolean(), "'emergency_exceptions' must be true or false");
       p.emergency_exceptions = value.get<bool>();
@@ -169,18 +172,13 @@ std::string profile_to_json(const VehicleProfile& p) {
   nlohmann::json j;
   j["name"] = p.name;
   j["vmax_kmh"] = p.vmax_mps * 3.6;
-  j["height_m"] = p.height_m;
-  j["width_m"] = p.width_m;
-  j["weight_t"] = p.weight_t;
+  for (const auto& [key, field] : kNumbers) j[key] = p.*field;
   j["restriction_modes"] = nlohmann::json::array();
   for (const auto& [name, mode] : kModes) {
     if ((p.restriction_modes & maps::mode_bit(mode)) != 0) j["restriction_modes"].push_back(name);
   }
   j["emergency_exceptions"] = p.emergency_exceptions;
-  j["turn_penalty_s"] = p.turn_penalty_s;
-  j["crossing_penalty_s"] = p.crossing_penalty_s;
   j["uturn"] = p.uturn_policy == UturnPolicy::anywhere ? "anywhere" : "dead_ends";
-  j["uturn_penalty_s"] = p.uturn_penalty_s;
   for (int c = 0; c < maps::kRoadClassCount; ++c) {
     j["speed_factor"][std::string(maps::to_string(static_cast<maps::RoadClass>(c)))] = p.speed_factor[static_cast<std::size_t>(c)];
   }

@@ -6,6 +6,7 @@
 
 #include "planner/one_to_one_search.hpp"
 #include "maps/osm_import.hpp"
+#include "maps/synthetic_grid.hpp"
 #include "tests/planner/test_graphs.hpp"
 #include "tests/planner/test_graphs_line.hpp"
 
@@ -125,6 +126,30 @@ TEST(DStarLite, ReplanMatchesDijkstraAfterRandomUpdateSequences) {
     }
   }
   EXPECT_EQ(replans, kSequences * 25);
+}
+
+// A mission that touches a small part of a big graph holds a small part of its state: the per-vertex
+// records live in pages allocated on first write.
+TEST(DStarLite, MemoryGrowsWithTheSearchNotWithTheGraph) {
+  maps::GridSpec spec;
+  spec.rows = 200;
+  spec.cols = 200;
+  spec.seed = 5;
+  const auto g = maps::make_perturbed_grid(spec);
+  const CostOverlay overlay(g);
+  const TravelCost cost(g, overlay, {30.0});
+  // Two consecutive edges: a trip of one junction.
+  const EdgeId first{static_cast<std::uint32_t>(g.edge_count() / 2)};
+  const EdgeId second = *g.out_edges(g.head(first)).begin();
+  DStarLite dstar(cost, {{first, 0.0}}, {{second, g.length_m(second)}});
+  dstar.replan();
+  ASSERT_TRUE(dstar.route().found);
+  const double dense = static_cast<double>(g.turns().vertex_count() * sizeof(VertexState));
+  EXPECT_LT(static_cast<double>(dstar.memory_bytes()), 0.05 * dense) << dstar.memory_bytes() << " bytes";
+  // The far end of the city costs its pages once it is searched.
+  DStarLite across(cost, {{EdgeId{0}, 0.0}}, {{EdgeId{static_cast<std::uint32_t>(g.edge_count() - 1)}, 0.0}});
+  across.replan();
+  EXPECT_GT(across.memory_bytes(), dstar.memory_bytes());
 }
 
 TEST(DStarLite, ReplanMatchesDijkstraAfterCongestionUpdate) {
