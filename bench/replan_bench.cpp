@@ -37,11 +37,13 @@ std::optional<EdgePoint> drive(const planner::TravelCost& cost, const planner::R
     const EdgeId e = route.edges[i];
     const double from = i == 0 ? route.start.offset_m : 0.0;
     const double to = i + 1 == route.edges.size() ? route.goal.offset_m : g.length_m(e);
-    const double before_edge = i == 0 ? 0.0 : cost.node_delay_s(g.tail(e));
-    if (left <= before_edge) return EdgePoint{e, from};
+    // The turn onto e and the crossing of its tail, then e itself, as the cost model charges them.
+    const double before_edge =
+        i == 0 ? 0.0 : planner::add_cost(cost.turn_onto(route.point_on(i - 1, 0.0).vertex(), e).first, cost.node_delay_s(g.tail(e)));
+    if (left <= before_edge) return route.point_on(i, from);
     left -= before_edge;
     const double t = cost.partial_time_s(e, from, to);
-    if (left < t) return EdgePoint{e, from + (left / t) * (to - from)};  // as the cost model: delay spread
+    if (left < t) return route.point_on(i, from + (left / t) * (to - from));  // as the cost model: delay spread
     left -= t;
   }
   return std::nullopt;

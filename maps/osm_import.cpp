@@ -10,6 +10,7 @@
 #include <unordered_map>
 
 #include "maps/errors.hpp"
+#include "maps/osm_restrictions.hpp"
 #include "maps/osm_tags.hpp"
 #include "maps/progress.hpp"
 
@@ -30,33 +31,6 @@ struct KeptWay {
 std::string_view tag(const osmium::TagList& tags, const char* key) {
   const char* v = tags.get_value_by_key(key);
   return v == nullptr ? std::string_view{} : std::string_view{v};
-}
-
-// A type=restriction relation in OSM terms, one per restriction key it carries.
-struct OsmRestriction {
-  std::vector<osmium::object_id_type> from_ways;
-  std::vector<osmium::object_id_type> via_nodes;  // at most one in valid data
-  std::vector<osmium::object_id_type> via_ways;
-  std::vector<osmium::object_id_type> to_ways;
-  bool only = false;
-  bool u_turn = false;  // no_u_turn / only_u_turn: the to edge is the from edge's twin
-  RestrictionMode mode = RestrictionMode::all;
-  bool except_emergency = false;
-};
-
-// True when a ';'-list names an emergency vehicle: `except=emergency` or `except=psv` lifts the
-// restriction for an ambulance or a fire engine.
-bool except_names_emergency(std::string_view list) {
-  while (!list.empty()) {
-    const auto semi = list.find(';');
-    std::string_view item = list.substr(0, semi);
-    while (!item.empty() && item.front() == ' ') item.remove_prefix(1);
-    while (!item.empty() && item.back() == ' ') item.remove_suffix(1);
-    if (item == "emergency" || item == "psv") return true;
-    if (semi == std::string_view::npos) break;
-    list.remove_prefix(semi + 1);
-  }
-  return false;
 }
 
 // Streams ways (with node locations filled in by NodeLocationsForWays) and signal nodes.
@@ -127,44 +101,9 @@ class RoadCollector : public osmium::handler::Handler {
     }
   }
 
-  // Turn restrictions. `restriction:conditional` (time or vehicle conditions) is ignored: an
-  // emergency run cannot wait for a condition to be evaluated, and OSRM's car profile ignores it too.
+  // Turn restrictions (maps/osm_restrictions.hpp).
   void relation(const osmium::Relation& rel) {
-    const auto& t = rel.tags();
-    if (tag(t, "type") != "restriction") return;
-    OsmRestriction base;
-    for (const auto& m : rel.members()) {
-      const std::string_view role = m.role();
-      const bool way = m.type() == osmium::item_type::way;
-      if (role == "from" && way) base.from_ways.push_back(m.ref());
-      if (role == "to" && way) base.to_ways.push_back(m.ref());
-      if (role == "via" && way) base.via_ways.push_back(m.ref());
-      if (role == "via" && m.type() == osmium::item_type::node) base.via_nodes.push_back(m.ref());
-    }
-    if (base.from_ways.empty() || base.to_ways.empty() || base.via_nodes.size() + (base.via_ways.empty() ? 0 : 1) != 1) {
-      ++restrictions_malformed;
-      return;
-    }
-    base.except_emergency = except_names_emergency(tag(t, "except"));
-    static constexpr std::pair<const char*, RestrictionMode> kKeys[] = {
-        {"restriction", RestrictionMode::all},
-        {"restriction:motorcar", RestrictionMode::motorcar},
-        {"restriction:motor_vehicle", RestrictionMode::motor_vehicle},
-        {"restriction:vehicle", RestrictionMode::vehicle},
-        {"restriction:emergency", RestrictionMode::emergency},
-        {"restriction:hgv", RestrictionMode::hgv},
-    };
-    for (const auto& [key, mode] : kKeys) {
-      const std::string_view value = tag(t, key);
-      const bool no = value.starts_with("no_");
-      const bool only = value.starts_with("only_");
-      if (!no && !only) continue;
-      OsmRestriction r = base;
-      r.only = only;
-      r.u_turn = value.ends_with("u_turn");
-      r.mode = mode;
-      restrictions.push_back(std::move(r));
-    }
+    if (!read_restriction(rel, restrictions)) ++restrictions_malformed;
   }
 
   std::size_t ways_read = 0;
@@ -202,102 +141,6 @@ RoadCollector read_file(const std::filesystem::path& path, const OsmImportOption
   }
   return collector;
 }
-
-// The edge paths an OSM restriction names in the built graph: every from edge arriving at the via
-// node (or at the start of the via ways), through the via ways' edges in any order they connect,
-// onto every to edge. A restriction whose members are not in the graph (cut off by the extract,
-// one-way the other way, not drivable) resolves to nothing.
-class RestrictionResolver {
- public:
-  RestrictionResolver(const RoadGraph& graph, const std::vector<OsmRestriction>& restrictions) : g_(graph) {
-    std::vector<osmium::object_id_type> ways, nodes;
-    for (const auto& r : restrictions) {
-      ways.insert(ways.end(), r.from_ways.begin(), r.from_ways.end());
-      ways.insert(ways.end(), r.via_ways.begin(), r.via_ways.end());
-      ways.insert(ways.end(), r.to_ways.begin(), r.to_ways.end());
-      nodes.insert(nodes.end(), r.via_nodes.begin(), r.via_nodes.end());
-    }
-    std::sort(ways.begin(), ways.end());
-    std::sort(nodes.begin(), nodes.end());
-    for (EdgeId e : g_.edges()) {
-      if (std::binary_search(ways.begin(), ways.end(), g_.osm_way(e).v)) edges_of_way_[g_.osm_way(e).v].push_back(e);
-    }
-    for (NodeId v : g_.nodes()) {
-      if (std::binary_search(nodes.begin(), nodes.end(), g_.osm_node(v).v)) nodes_of_osm_[g_.osm_node(v).v].push_back(v);
-    }
-  }
-
-  // Appends the restriction's paths; returns how many.
-  std::size_t resolve(const OsmRestriction& r, TurnRestrictions& out) const {
-    std::size_t added = 0;
-    auto emit = [&](const std::vector<EdgeId>& path) {
-      out.add(path, r.only, r.mode, r.except_emergency);
-      ++added;
-    };
-    for (auto from_way : r.from_ways) {
-      for (auto to_way : r.to_ways) {
-        if (!r.via_nodes.empty()) {
-          const auto it = nodes_of_osm_.find(r.via_nodes.front());
-          if (it == nodes_of_osm_.end()) continue;
-          for (NodeId via : it->second) {
-            for (EdgeId e : g_.in_edges(via)) {
-              if (g_.osm_way(e).v != from_way) continue;
-              for (EdgeId f : g_.out_edges(via)) {
-                if (g_.osm_way(f).v != to_way) continue;
-                // From a way onto itself: the U-turn for *_u_turn, otherwise straight on through.
-                if (from_way == to_way && (f == g_.twin(e)) != r.u_turn) continue;
-                emit({e, f});
-              }
-            }
-          }
-          continue;
-        }
-        const auto from = edges_of_way_.find(from_way);
-        if (from == edges_of_way_.end()) continue;
-        for (EdgeId e : from->second) {
-          std::vector<EdgeId> path{e};
-          walk_via(r, to_way, path, emit);
-        }
-      }
-    }
-    return added;
-  }
-
- private:
-  // Depth-first along the via ways from the head of path.back(), emitting every path that reaches a
-  // to edge after driving all the via ways.
-  template <class Emit>
-  void walk_via(const OsmRestriction& r, osmium::object_id_type to_way, std::vector<EdgeId>& path, Emit& emit) const {
-    constexpr std::size_t kMaxViaEdges = 32;
-    const NodeId at = g_.head(path.back());
-    const bool on_via = path.size() > 1;
-    for (EdgeId f : g_.out_edges(at)) {
-      if (f == g_.twin(path.back())) continue;
-      const auto way = g_.osm_way(f).v;
-      if (on_via && way == to_way && covers_via(r, path)) {
-        path.push_back(f);
-        emit(path);
-        path.pop_back();
-      }
-      const bool via = std::find(r.via_ways.begin(), r.via_ways.end(), way) != r.via_ways.end();
-      if (!via || path.size() > kMaxViaEdges || std::find(path.begin(), path.end(), f) != path.end()) continue;
-      path.push_back(f);
-      walk_via(r, to_way, path, emit);
-      path.pop_back();
-    }
-  }
-  // Every via way is driven by some edge of path (path[0] is the from edge).
-  bool covers_via(const OsmRestriction& r, const std::vector<EdgeId>& path) const {
-    for (auto w : r.via_ways) {
-      if (std::none_of(path.begin() + 1, path.end(), [&](EdgeId e) { return g_.osm_way(e).v == w; })) return false;
-    }
-    return true;
-  }
-
-  const RoadGraph& g_;
-  std::unordered_map<osmium::object_id_type, std::vector<EdgeId>> edges_of_way_;
-  std::unordered_map<osmium::object_id_type, std::vector<NodeId>> nodes_of_osm_;
-};
 
 }  // namespace
 

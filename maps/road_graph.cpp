@@ -65,7 +65,7 @@ void validate(const RoadGraphData& d) {
               r.first.front() == 0 && r.first.back() == r.edges.size(),
           "turn restriction arrays differ in length");
   for (std::size_t i = 0; i < r.size(); ++i) {
-    require(r.first[i] + 2 <= r.first[i + 1], "a turn restriction needs a from and a to edge");
+    require(r.first[i + 1] >= r.first[i] && r.first[i + 1] - r.first[i] >= 2, "a turn restriction needs a from and a to edge");
     require(r.mode[i] <= static_cast<std::uint8_t>(RestrictionMode::hgv), "unknown turn restriction mode");
   }
   for (std::size_t i = 0; i < r.size(); ++i) {

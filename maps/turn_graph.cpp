@@ -75,19 +75,29 @@ TurnGraph::TurnGraph(const RoadGraphData& d) : edge_count_(d.edge_head.size()) {
   }
 
   // Restrictions. A via-way restriction (from, via..., to) must know that the vehicle entered the
-  // via edges from `from`: the turn from -> via1 leads to a copy of via1, whose turns are via1's
-  // except that the one onto via2 leads to a copy of via2, and so on; the last copy carries the ban.
-  // Restrictions that share a from edge and a first stretch of via edges share the copies (a trie),
-  // so each keeps its meaning.
+  // via edges from `from`: the turn from -> via1 leads to a copy of via1 (a state "on via1, having
+  // come from `from`"), whose turns are via1's except that the one onto via2 leads to a copy of
+  // via2, and so on; the last copy carries the ban. The states form a trie over restriction paths,
+  // completed as an Aho-Corasick automaton: a copy also carries every ban, and follows every
+  // redirect, of the longest shorter history that is itself a state (at least the plain edge). So
+  // restrictions that overlap keep all their meanings, whatever their order in the file.
   std::vector<std::vector<Arc>> copies;
+  std::vector<std::vector<EdgeId>> history;  // per copy: the edges driven, the copy's own last
   auto arcs_of = [&](std::uint32_t v) -> std::span<Arc> {
     if (v < m) return {base.data() + base_first[v], base_first[v + 1] - base_first[v]};
     return copies[v - m];
   };
   auto edge_of_vertex = [&](std::uint32_t v) { return v < m ? EdgeId{v} : copy_edge_[v - m]; };
-  // An only_* restriction allows, at the end of its path, just its to edge. When one restriction
-  // resolves to several paths (a to way that runs both ways from the via node), the allowed set at
-  // that vertex is the union of their to edges, so the bans wait until every path is known.
+  auto arc_onto = [&](std::uint32_t v, EdgeId next) -> Arc* {
+    for (Arc& a : arcs_of(v)) {
+      if (edge_of_vertex(a.other) == next) return &a;
+    }
+    return nullptr;
+  };
+  constexpr std::uint16_t kBanBits = 0x0fff;
+  // An only_* restriction allows, at each step of its path, just the next edge. When one
+  // restriction resolves to several paths (a way that runs both ways from the via node), the allowed
+  // set at a state is the union of theirs, so these bans wait until every path is known.
   std::map<std::pair<std::uint32_t, std::uint16_t>, std::vector<EdgeId>> only_allowed;
   const TurnRestrictions& r = d.restrictions;
   for (std::size_t k = 0; k < r.size(); ++k) {
@@ -98,40 +108,56 @@ TurnGraph::TurnGraph(const RoadGraphData& d) : edge_count_(d.edge_head.size()) {
     std::uint32_t cur = path[0].v;
     for (std::size_t i = 1; i < path.size(); ++i) {
       const EdgeId next = path[i];
-      const bool last = i + 1 == path.size();
-      std::size_t pick = arcs_of(cur).size();
-      for (std::size_t j = 0; j < arcs_of(cur).size(); ++j) {
-        if (edge_of_vertex(arcs_of(cur)[j].other) == next) {
-          pick = j;
-        } else if (only && !last) {
-          arcs_of(cur)[j].bits |= ban;  // along an only_ path's via edges, every way off it is closed
-        }
-      }
-      if (pick == arcs_of(cur).size()) {
+      Arc* arc = arc_onto(cur, next);
+      if (arc == nullptr) {
         throw MapError("inconsistent road graph: turn restriction " + std::to_string(k) + " names edges that do not meet");
       }
-      if (last) {
-        if (only) {
-          only_allowed[{cur, ban}].push_back(next);
-        } else {
-          arcs_of(cur)[pick].bits |= ban;
-        }
+      if (only) only_allowed[{cur, ban}].push_back(next);
+      if (i + 1 == path.size()) {
+        if (!only) arc->bits |= ban;
         break;
       }
-      if (arcs_of(cur)[pick].other < m) {
-        // A copy of the via edge with its own turns, reached only through this turn.
+      if (arc->other < m) {
+        // A new state: on `next`, having driven the path so far. Its turns are filled in below.
         const auto copy = static_cast<std::uint32_t>(m + copies.size());
+        std::vector<EdgeId> driven = cur < m ? std::vector<EdgeId>{EdgeId{cur}} : history[cur - m];
+        driven.push_back(next);
+        arc->other = copy;
         const auto original = arcs_of(next.v);
-        copies.emplace_back(original.begin(), original.end());
+        copies.emplace_back(original.begin(), original.end());  // completed by the failure links below
         copy_edge_.push_back(next);
-        arcs_of(cur)[pick].other = copy;
+        history.push_back(std::move(driven));
       }
-      cur = arcs_of(cur)[pick].other;
+      cur = arc->other;
     }
   }
   for (const auto& [where, allowed] : only_allowed) {
     for (Arc& a : arcs_of(where.first)) {
       if (std::find(allowed.begin(), allowed.end(), edge_of_vertex(a.other)) == allowed.end()) a.bits |= where.second;
+    }
+  }
+  // Failure links, shallow states first: a copy inherits the bans and redirects of the longest
+  // proper suffix of its history that is a state (the plain edge when no longer one is).
+  std::map<std::vector<EdgeId>, std::uint32_t> state_of;
+  for (std::size_t c = 0; c < copies.size(); ++c) state_of.emplace(history[c], static_cast<std::uint32_t>(m + c));
+  std::vector<std::uint32_t> by_depth(copies.size());
+  for (std::size_t c = 0; c < copies.size(); ++c) by_depth[c] = static_cast<std::uint32_t>(c);
+  std::stable_sort(by_depth.begin(), by_depth.end(), [&](std::uint32_t x, std::uint32_t y) { return history[x].size() < history[y].size(); });
+  for (std::uint32_t c : by_depth) {
+    const std::vector<EdgeId>& h = history[c];
+    std::uint32_t fallback = h.back().v;
+    for (std::size_t skip = 1; skip + 1 < h.size(); ++skip) {
+      const auto it = state_of.find(std::vector<EdgeId>(h.begin() + static_cast<std::ptrdiff_t>(skip), h.end()));
+      if (it != state_of.end()) {
+        fallback = it->second;
+        break;
+      }
+    }
+    for (Arc& a : copies[c]) {
+      const Arc* f = arc_onto(fallback, edge_of_vertex(a.other));
+      if (f == nullptr) continue;
+      a.bits |= static_cast<std::uint16_t>(f->bits & kBanBits);
+      if (a.other < m && f->other >= m) a.other = f->other;
     }
   }
 

@@ -21,17 +21,20 @@ Route make_route(const TravelCost& cost, EdgePoint start, std::vector<EdgeId> ed
   if (r.edges.size() == 1) {
     r.travel_time_s = cost.partial_time_s(start.edge, start.offset_m, goal.offset_m);
     r.length_m = std::max(0.0, goal.offset_m - start.offset_m);
+    r.turn_vertices.push_back(start.vertex());
   } else {
     double t = cost.partial_time_s(start.edge, start.offset_m, g.length_m(start.edge));
     double len = g.length_m(start.edge) - start.offset_m;
     // Follow the turn graph as the searches do, so that a via-way restriction's copies count.
-    std::uint32_t vertex = start.edge.v;
+    std::uint32_t vertex = start.vertex();
+    r.turn_vertices.push_back(vertex);
     for (std::size_t i = 1; i < r.edges.size(); ++i) {
       const EdgeId e = r.edges[i];
       r.nodes.push_back(g.tail(e));
       r.arrival_s.push_back(t);
       const auto [turn, next] = cost.turn_onto(vertex, e);
       vertex = next;
+      r.turn_vertices.push_back(vertex);
       if (i + 1 < r.edges.size()) {
         t = add_cost(t, add_cost(turn, cost.transit_s(e)));
         len += g.length_m(e);

@@ -20,6 +20,14 @@ struct Route {
   std::vector<EdgeId> edges;      // edges.front() == start.edge, edges.back() == goal.edge
   std::vector<NodeId> nodes;      // intersections crossed, nodes[i] = head(edges[i])
   std::vector<double> arrival_s;  // from now until the vehicle reaches nodes[i]'s stop line
+  // The turn-graph state on each edge (EdgePoint::turn_vertex): give it back with a start point on
+  // edges[i], so a replan keeps what a via-way restriction remembers.
+  std::vector<std::uint32_t> turn_vertices;
+
+  // The point `offset_m` along edges[i], in the state the route drives it.
+  [[nodiscard]] EdgePoint point_on(std::size_t i, double offset_m) const {
+    return {edges[i], offset_m, i < turn_vertices.size() ? turn_vertices[i] : EdgePoint::kPlainEdge};
+  }
 
   // Remaining travel time from arriving at `node` to the goal, if the route crosses it.
   [[nodiscard]] std::optional<double> cost_to_goal_s(NodeId node) const;

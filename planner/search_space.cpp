@@ -69,6 +69,11 @@ void SearchSpace::normalize(std::vector<EdgePoint>& points, const char* what) co
     }
     if (!std::isfinite(p.offset_m)) throw std::invalid_argument(std::string(what) + " point offset is not finite");
     p.offset_m = std::clamp(p.offset_m, 0.0, cost_->graph().length_m(p.edge));
+    if (p.turn_vertex != EdgePoint::kPlainEdge &&
+        (p.turn_vertex >= turns_->vertex_count() || turns_->edge_of(p.turn_vertex) != p.edge)) {
+      throw std::invalid_argument(std::string(what) + " point names turn-graph state " + std::to_string(p.turn_vertex) +
+                                  ", which is not on edge " + std::to_string(p.edge.v));
+    }
   }
 }
 

@@ -90,7 +90,7 @@ class SearchSpace {
     const auto& g = cost_->graph();
     if (u == start()) {
       for (const EdgePoint& s : starts_) {
-        f(vertex(s.edge), cost_->partial_time_s(s.edge, s.offset_m, g.length_m(s.edge)), s.edge);
+        f(Vertex{s.vertex()}, cost_->partial_time_s(s.edge, s.offset_m, g.length_m(s.edge)), s.edge);
         for (const EdgePoint& t : goals_) {
           if (t.edge == s.edge && t.offset_m >= s.offset_m) f(goal(), cost_->partial_time_s(s.edge, s.offset_m, t.offset_m), s.edge);
         }
@@ -143,10 +143,8 @@ class SearchSpace {
       const double turn = cost_->turn_s(a);
       if (turn < kInfCost) f(Vertex{a.other}, add_cost(turn, drive));
     }
-    if (v == vertex(e)) {
-      for (const EdgePoint& s : starts_) {
-        if (s.edge == e) f(start(), cost_->partial_time_s(s.edge, s.offset_m, g.length_m(s.edge)));
-      }
+    for (const EdgePoint& s : starts_) {
+      if (s.vertex() == v.v) f(start(), cost_->partial_time_s(s.edge, s.offset_m, g.length_m(s.edge)));
     }
   }
 

@@ -18,6 +18,12 @@ namespace corridor::planner {
 struct EdgePoint {
   EdgeId edge;
   double offset_m = 0.0;
+  // The vehicle's state in the turn graph (maps/turn_graph.hpp) while on `edge`: a copy of the edge
+  // when a via-way restriction has to remember how the vehicle got onto it. kPlainEdge: the edge's
+  // own vertex (where it came from does not matter, or is not known).
+  static constexpr std::uint32_t kPlainEdge = std::numeric_limits<std::uint32_t>::max();
+  std::uint32_t turn_vertex = kPlainEdge;
+  [[nodiscard]] std::uint32_t vertex() const { return turn_vertex == kPlainEdge ? edge.v : turn_vertex; }
 };
 
 class TravelCost {

@@ -220,7 +220,7 @@ std::vector<planner::EdgePoint> DispatchService::endpoints(const maps::SnapResul
 }
 
 // The mission's built-in profile, at its own top speed. A row stored with an unknown profile name
-// (by a later version) plans as an ambulance rather than failing the resume.
+// (by a later version) is resumed as an ambulance (see the resume).
 planner::VehicleProfile DispatchService::vehicle_profile(const MissionRow& row) {
   planner::VehicleProfile p = row.profile == "fire_engine" ? planner::fire_engine_profile() : planner::ambulance_profile();
   p.vmax_mps = row.vmax_kmh / 3.6;
@@ -547,8 +547,14 @@ PositionResult DispatchService::report_position(const PositionReport& p, double 
 
   // Signals behind the vehicle: every intersection of the old route before its current edge. A
   // matched point already knows its direction; a raw snap asks the heading.
-  const auto points = tracked.match.matched ? std::vector<planner::EdgePoint>{{snap.edge, snap.offset_m}}
-                                            : endpoints(snap, Role::start, p.heading_deg);
+  auto points = tracked.match.matched ? std::vector<planner::EdgePoint>{{snap.edge, snap.offset_m}}
+                                      : endpoints(snap, Role::start, p.heading_deg);
+  // On its route, the vehicle is in the turn-graph state the route drove it in: a via-way
+  // restriction it has entered still binds it after the replan.
+  for (planner::EdgePoint& q : points) {
+    const auto on = std::find(m.route.edges.begin(), m.route.edges.end(), q.edge);
+    if (on != m.route.edges.end()) q.turn_vertex = m.route.point_on(static_cast<std::size_t>(on - m.route.edges.begin()), 0.0).turn_vertex;
+  }
   const auto pos_in_route = std::find_if(m.route.edges.begin(), m.route.edges.end(), [&](EdgeId e) {
     return std::any_of(points.begin(), points.end(), [&](const planner::EdgePoint& q) { return q.edge == e; });
   });
@@ -628,8 +634,13 @@ void DispatchService::restore(double now_s) {
     if (c.expires_at_s) expiries_.emplace(*c.expires_at_s, std::make_pair(c.edge, seq));
   }
   Staged staged;
-  for (const MissionRow& row : store_->missions(std::nullopt)) {
+  for (MissionRow row : store_->missions(std::nullopt)) {
     next_mission_id_ = std::max(next_mission_id_, row.id + 1);
+    if (row.profile != "ambulance" && row.profile != "fire_engine") {
+      // Written by a later version: plan, and say, what this build knows.
+      spdlog::warn("event=mission_profile_unknown mission={} profile={} planned_as=ambulance", row.id, row.profile);
+      row.profile = "ambulance";
+    }
     const auto last = store_->last_position(row.vehicle_id);
     if (row.state != MissionState::active) {
       // Finished missions stay readable; they need no planner.

@@ -83,7 +83,8 @@ MissionRequest mission_request_from_json(const json& j) {
       throw bad_request("field 'profile' must be \"ambulance\" or \"fire_engine\"");
     }
     r.profile = it->get<std::string>();
-    r.vmax_kmh = planner::builtin_profile(r.profile).vmax_mps * 3.6;
+    // Rounded to the micro-km/h: 120 / 3.6 * 3.6 is not exactly 120 in binary.
+    r.vmax_kmh = std::round(planner::builtin_profile(r.profile).vmax_mps * 3.6 * 1e6) / 1e6;
   }
   if (auto v = optional_number(j, "vmax_kmh")) r.vmax_kmh = *v;
   return r;

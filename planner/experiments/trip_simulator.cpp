@@ -101,6 +101,8 @@ class Vehicle {
 
   [[nodiscard]] double time_s() const { return time_s_; }
   [[nodiscard]] NodeId at() const { return at_; }
+  // The turn-graph state of the last edge driven: how a via-way restriction knows where it came from.
+  [[nodiscard]] std::uint32_t vertex() const { return vertex_; }
 
  private:
   const TripScenario& s_;
@@ -177,7 +179,7 @@ TripResult drive_trip(const maps::RoadGraph& graph, const TripScenario& scenario
 
     // At the next stop line: take in what has appeared since, and repair the plan from here.
     const std::vector<EdgeId> changed = known.reveal_until(ev.time_s());
-    planner.move_start({{e, graph.length_m(e)}});
+    planner.move_start({{e, graph.length_m(e), ev.vertex()}});
     if (!changed.empty()) planner.edges_changed(changed);
     const auto t0 = std::chrono::steady_clock::now();
     const ReplanStats stats = planner.replan();

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <thread>
 
@@ -46,6 +47,56 @@ TEST(GraphCache, RoundTripPreservesTheGraph) {
   const RoadGraph back = read_graph_cache(file, &source);
   expect_same_graph(g, back);
   EXPECT_EQ(source, (CacheSource{123, 456}));
+}
+
+// Turn restrictions, limits and roundabouts survive the cache; the turn graph rebuilt from them on
+// load is the same.
+TEST(GraphCache, RoundTripKeepsTheTurnModel) {
+  TempDir dir;
+  RoadGraphData d = small_grid().data();
+  const EdgeId a{0};
+  const EdgeId b = *RoadGraph(d).out_edges(d.edge_head[0]).begin();
+  d.restrictions.add({a, b}, false, RestrictionMode::motorcar, true);
+  d.edge_limits.push_back({a, 3.2f, 0.0f, 7.5f});
+  d.roundabout_edges.push_back(b);
+  d.left_hand_traffic = {1};
+  const RoadGraph g(std::move(d));
+  const auto file = dir.path() / "t.cgr";
+  write_graph_cache(file, g, CacheSource{1, 2});
+  const RoadGraph back = read_graph_cache(file);
+  EXPECT_EQ(back.data().restrictions.edges, g.data().restrictions.edges);
+  EXPECT_EQ(back.data().restrictions.mode, g.data().restrictions.mode);
+  EXPECT_EQ(back.data().restrictions.except_emergency, g.data().restrictions.except_emergency);
+  ASSERT_EQ(back.edge_limits().size(), 1u);
+  EXPECT_FLOAT_EQ(back.edge_limits()[0].max_height_m, 3.2f);
+  EXPECT_TRUE(back.on_roundabout(b));
+  EXPECT_TRUE(back.left_hand_traffic());
+  EXPECT_EQ(back.turns().arc_count(), g.turns().arc_count());
+}
+
+// A crafted restriction table (offsets that wrap, edges out of range, edges that do not meet) is
+// refused with a MapError, never read out of bounds.
+TEST(GraphCache, InconsistentRestrictionsAreRejected) {
+  const RoadGraph g = small_grid();
+  auto with = [&](std::vector<std::uint32_t> first, std::vector<EdgeId> edges) {
+    RoadGraphData d = g.data();
+    const std::size_t n = first.size() - 1;
+    d.restrictions.first = std::move(first);
+    d.restrictions.edges = std::move(edges);
+    d.restrictions.only.assign(n, 0);
+    d.restrictions.mode.assign(n, 0);
+    d.restrictions.except_emergency.assign(n, 0);
+    return d;
+  };
+  const EdgeId e0{0};
+  EXPECT_THROW(RoadGraph(with({0, 0xFFFFFFFFu, 5}, {e0, e0, e0, e0, e0})), MapError);
+  EXPECT_THROW(RoadGraph(with({0, 2}, {e0, EdgeId{999999}})), MapError);
+  const EdgeId far{static_cast<std::uint32_t>(g.edge_count() - 1)};
+  ASSERT_NE(g.tail(far), g.head(e0));
+  EXPECT_THROW(RoadGraph(with({0, 2}, {e0, far})), MapError);
+  RoadGraphData bad_limits = g.data();
+  bad_limits.edge_limits.push_back({EdgeId{0}, std::nanf(""), 0, 0});
+  EXPECT_THROW(RoadGraph(std::move(bad_limits)), MapError);
 }
 
 TEST(GraphCache, CorruptByteIsDetected) {

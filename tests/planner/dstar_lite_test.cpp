@@ -140,6 +140,7 @@ TEST(DStarLite, MemoryGrowsWithTheSearchNotWithTheGraph) {
   const TravelCost cost(g, overlay, {30.0});
   // Two consecutive edges: a trip of one junction.
   const EdgeId first{static_cast<std::uint32_t>(g.edge_count() / 2)};
+  ASSERT_FALSE(g.out_edges(g.head(first)).empty());  // the largest strongly connected part: never a sink
   const EdgeId second = *g.out_edges(g.head(first)).begin();
   DStarLite dstar(cost, {{first, 0.0}}, {{second, g.length_m(second)}});
   dstar.replan();

@@ -4,6 +4,8 @@
 // turn costs and the side of the road, and physical limits. Dijkstra and D* Lite must agree on each.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "maps/osm_import.hpp"
 #include "planner/dstar_lite.hpp"
 #include "planner/one_to_one_search.hpp"
@@ -184,18 +186,38 @@ TEST(TurnRules, NoUturnRestrictionAtADeadEndSpur) {
 }
 
 TEST(TurnRules, ViaWayRestrictionBindsOnlyThePathThroughIt) {
-  // From South through North onto the Ring: forbidden. From West through North onto the Ring: fine.
+  // From South through North, left onto the Ring: forbidden. The Ring runs through 5 both ways, and
+  // "left" names the west side only. From West through North onto the Ring: fine.
   const auto g = plus_map({restriction({{'w', kSouth, "from"}, {'w', kNorth, "via"}, {'w', kRing, "to"}}, {{"restriction", "no_left_turn"}})});
   const auto goal = ring_west_of_5(g);
   const Trip from_south = drive(g, ambulance_profile(), {{edge(g, 4, 2), 50.0}}, goal);
   ASSERT_TRUE(from_south.route.found);
-  for (std::size_t i = 2; i < from_south.ways.size(); ++i) {
-    EXPECT_FALSE(from_south.ways[i - 2] == kSouth && from_south.ways[i - 1] == kNorth && from_south.ways[i] == kRing);
-  }
+  const std::vector<EdgeId> banned{edge(g, 4, 2), edge(g, 2, 5), edge(g, 5, 1)};
+  EXPECT_EQ(std::search(from_south.route.edges.begin(), from_south.route.edges.end(), banned.begin(), banned.end()),
+            from_south.route.edges.end());
   EXPECT_EQ(drive(g, ambulance_profile(), {{edge(g, 1, 2), 50.0}}, goal).ways, (std::vector<long long>{kWest, kNorth, kRing}));
   // The same trip with no restriction goes straight up North.
   EXPECT_EQ(drive(plus_map({}), ambulance_profile(), {{edge(g, 4, 2), 50.0}}, goal).ways,
             (std::vector<long long>{kSouth, kNorth, kRing}));
+  // Right onto the Ring from the same path is not what the restriction names.
+  EXPECT_EQ(drive(g, ambulance_profile(), {{edge(g, 4, 2), 50.0}}, testing::with_twin(g, {edge(g, 5, 3), 50.0})).ways,
+            (std::vector<long long>{kSouth, kNorth, kRing}));
+}
+
+// Two restrictions that overlap: a via-way one through North, and a via-node one on North's far
+// end. The copy of North that remembers "came from South" must still carry the via-node ban,
+// whichever relation comes first in the file.
+TEST(TurnRules, OverlappingRestrictionsKeepBothMeanings) {
+  const auto via_way = restriction({{'w', kSouth, "from"}, {'w', kNorth, "via"}, {'w', kRing, "to"}}, {{"restriction", "no_left_turn"}});
+  const auto via_node = restriction({{'w', kNorth, "from"}, {'n', 5, "via"}, {'w', kRing, "to"}}, {{"restriction", "no_right_turn"}});
+  for (const auto& relations : std::vector<std::vector<FixtureRelation>>{{via_way, via_node}, {via_node, via_way}}) {
+    const auto g = plus_map(relations);
+    const Trip t = drive(g, ambulance_profile(), {{edge(g, 4, 2), 50.0}}, testing::with_twin(g, {edge(g, 5, 3), 50.0}));
+    ASSERT_TRUE(t.route.found);
+    const std::vector<EdgeId> right{edge(g, 2, 5), edge(g, 5, 3)};
+    EXPECT_EQ(std::search(t.route.edges.begin(), t.route.edges.end(), right.begin(), right.end()), t.route.edges.end())
+        << "the via-node ban was lost on the copy";
+  }
 }
 
 TEST(TurnRules, OnlyViaWayMustFollowTheWholePath) {
