@@ -26,7 +26,10 @@ class TickDijkstra {
     dist_[source.index()] = 0;
     open.emplace(0, source.v);
     while (!open.empty()) {
-      const auto [du, u] = open.top();
+      // Plain copies, not a structured binding: clang (the fuzz build) does not let a lambda
+      // capture a binding.
+      const Ticks du = open.top().first;
+      const std::uint32_t u = open.top().second;
       open.pop();
       if (du != dist_[u]) continue;
       auto relax = [&](std::uint32_t e, NodeId v) {

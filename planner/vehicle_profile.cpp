@@ -88,7 +88,8 @@ VehicleProfile profile_from_json(std::string_view text) {
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {
+    // parse_error, and out_of_range for a number too large for a double (found by profile_fuzzer).
     throw ProfileError(std::string("vehicle profile is not valid JSON: ") + e.what());
   }
   require(j.is_object(), "must be a JSON object");
@@ -97,7 +98,9 @@ VehicleProfile profile_from_json(std::string_view text) {
     require(base->is_string(), "'base' must be a string");
     p = builtin_profile(base->get<std::string>());
   }
-  for (const auto& [key, value] : j.items()) {
+  for (const auto& item : j.items()) {
+    const std::string& key = item.key();  // not a structured binding: the lambda below captures it
+    const nlohmann::json& value = item.value();
     if (key == "base") continue;
     if (key == "name") {
       require(value.is_string(), "'name' must be a string");

@@ -40,6 +40,7 @@ TEST(VehicleProfile, BadJsonIsAClearError) {
     return std::string("accepted");
   };
   EXPECT_NE(error_of("{").find("not valid JSON"), std::string::npos);
+  EXPECT_NE(error_of(R"({"height_m": 1e4444})").find("not valid JSON"), std::string::npos);  // overflows a double
   EXPECT_NE(error_of("[]").find("object"), std::string::npos);
   EXPECT_NE(error_of(R"({"height": 3})").find("unknown key 'height'"), std::string::npos);
   EXPECT_NE(error_of(R"({"height_m": "tall"})").find("'height_m' must be a number"), std::string::npos);
