@@ -123,8 +123,13 @@ TurnGraph::TurnGraph(const RoadGraphData& d) : edge_count_(d.edge_head.size()) {
         std::vector<EdgeId> driven = cur < m ? std::vector<EdgeId>{EdgeId{cur}} : history[cur - m];
         driven.push_back(next);
         arc->other = copy;
+        // The edge's own turns, with plain targets: the redirects its turns may have (trie children
+        // of the plain edge's state) are inherited by the failure links below, never followed as
+        // this state's own children during insertion.
         const auto original = arcs_of(next.v);
-        copies.emplace_back(original.begin(), original.end());  // completed by the failure links below
+        std::vector<Arc> turns(original.begin(), original.end());
+        for (Arc& t : turns) t.other = edge_of_vertex(t.other).v;
+        copies.push_back(std::move(turns));
         copy_edge_.push_back(next);
         history.push_back(std::move(driven));
       }

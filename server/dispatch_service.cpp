@@ -549,11 +549,17 @@ PositionResult DispatchService::report_position(const PositionReport& p, double 
   // matched point already knows its direction; a raw snap asks the heading.
   auto points = tracked.match.matched ? std::vector<planner::EdgePoint>{{snap.edge, snap.offset_m}}
                                       : endpoints(snap, Role::start, p.heading_deg);
-  // On its route, the vehicle is in the turn-graph state the route drove it in: a via-way
-  // restriction it has entered still binds it after the replan.
+  // Still on the edge the route started from, or just onto the next one, the vehicle is in the
+  // turn-graph state the route drove it in: a via-way restriction it has entered still binds it
+  // after the replan. Further along (reports missed, a loop that uses an edge twice, a vehicle that
+  // left the route and came back another way) the way it came is not known, and it starts afresh.
   for (planner::EdgePoint& q : points) {
-    const auto on = std::find(m.route.edges.begin(), m.route.edges.end(), q.edge);
-    if (on != m.route.edges.end()) q.turn_vertex = m.route.point_on(static_cast<std::size_t>(on - m.route.edges.begin()), 0.0).turn_vertex;
+    for (std::size_t i = 0; i < 2 && i < m.route.edges.size(); ++i) {
+      if (m.route.edges[i] == q.edge) {
+        q.turn_vertex = m.route.point_on(i, 0.0).turn_vertex;
+        break;
+      }
+    }
   }
   const auto pos_in_route = std::find_if(m.route.edges.begin(), m.route.edges.end(), [&](EdgeId e) {
     return std::any_of(points.begin(), points.end(), [&](const planner::EdgePoint& q) { return q.edge == e; });

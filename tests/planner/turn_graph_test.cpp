@@ -123,5 +123,45 @@ TEST(TurnGraph, AReplanFromARouteKeepsWhatARestrictionRemembers) {
   EXPECT_GT(replans, 300u);
 }
 
+// Two via-way restrictions where one's path contains the other's start: no_(A, B, C) and
+// no_(X, A, B, Y). In either file order, only traffic that came from X is barred from A -> B -> Y,
+// and traffic from X is barred from A -> B -> C too. (Inserting the longer one by following the
+// shorter one's copy used to bar A -> B -> Y for everyone in one order.)
+TEST(TurnGraph, NestedViaWayRestrictionsBindOnlyTheirOwnHistories) {
+  const auto grid = testing::random_grid(7, 6, 6);
+  EdgeId X, A, B, C, Y;
+  bool found = false;
+  for (EdgeId a : grid.edges()) {
+    for (EdgeId x : grid.in_edges(grid.tail(a))) {
+      for (EdgeId b : grid.out_edges(grid.head(a))) {
+        std::vector<EdgeId> exits;
+        for (EdgeId f : grid.out_edges(grid.head(b))) {
+          if (f != grid.twin(b)) exits.push_back(f);
+        }
+        if (found || x == grid.twin(a) || b == grid.twin(a) || exits.size() < 2) continue;
+        X = x, A = a, B = b, C = exits[0], Y = exits[1];
+        found = true;
+      }
+    }
+  }
+  ASSERT_TRUE(found);
+  for (bool short_first : {true, false}) {
+    maps::RoadGraphData d = grid.data();
+    d.restrictions = {};
+    const std::vector<EdgeId> shorter{A, B, C}, longer{X, A, B, Y};
+    d.restrictions.add(short_first ? shorter : longer, false, maps::RestrictionMode::all, false);
+    d.restrictions.add(short_first ? longer : shorter, false, maps::RestrictionMode::all, false);
+    const maps::RoadGraph g(std::move(d));
+    const CostOverlay overlay(g);
+    const TravelCost cost(g, overlay, testing::free_turns(30.0));
+    const std::uint32_t on_b = cost.turn_onto(A.v, B).second;  // came onto A from elsewhere
+    EXPECT_LT(cost.turn_onto(on_b, Y).first, kInfCost) << "A -> B -> Y barred for everyone, short_first=" << short_first;
+    EXPECT_EQ(cost.turn_onto(on_b, C).first, kInfCost) << short_first;
+    const std::uint32_t from_x = cost.turn_onto(cost.turn_onto(X.v, A).second, B).second;
+    EXPECT_EQ(cost.turn_onto(from_x, Y).first, kInfCost) << short_first;
+    EXPECT_EQ(cost.turn_onto(from_x, C).first, kInfCost) << short_first;
+  }
+}
+
 }  // namespace
 }  // namespace corridor::planner
