@@ -51,8 +51,8 @@ TurnGraph::TurnGraph(const RoadGraphData& d) : edge_count_(d.edge_head.size()) {
   // graph edges are its connections) gets plain arcs: its U-turns and angles are SUMO's business.
   std::vector<std::uint32_t> base_first(m + 1, 0);
   std::vector<Arc> base;
-  std::vector<double> arriving(m), leaving(m);
-  for (std::size_t e = 0; e < m; ++e) {
+  std::vector<double> arriving(turns_in_edges ? 0 : m), leaving(turns_in_edges ? 0 : m);
+  for (std::size_t e = 0; e < arriving.size(); ++e) {
     arriving[e] = arriving_bearing_deg(polyline(e));
     leaving[e] = leaving_bearing_deg(polyline(e));
   }

@@ -98,8 +98,7 @@ std::vector<RouteStep> route_steps(const maps::RoadGraph& g, const Route& route,
         s.ref = g.ref(exit_road);
         s.maneuver = ManeuverType::roundabout;
         s.exit = last + 1 < n ? roundabout_exit(g, route.edges, i, last) : 0;
-        s.turn_deg = maps::signed_turn_deg(maps::arriving_bearing_deg(g.geometry(in)),
-                                           maps::leaving_bearing_deg(g.geometry(exit_road)));
+        s.turn_deg = turn_between(g, in, exit_road);
         s.modifier = modifier_for_turn(s.turn_deg);
         s.location = g.position(g.tail(out));
         steps.push_back(s);

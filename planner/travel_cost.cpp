@@ -7,15 +7,14 @@
 namespace corridor::planner {
 
 TravelCost::TravelCost(const maps::RoadGraph& graph, const CostOverlay& overlay, VehicleProfile vehicle)
-    : graph_(&graph), overlay_(&overlay), profile_(std::move(vehicle)), vmax_mps_(profile_.vmax_mps) {
-  if (!(vmax_mps_ > 0.0) || !std::isfinite(vmax_mps_)) {
-    throw CostUpdateError("vehicle max speed must be a positive number, got " + std::to_string(vmax_mps_) + " m/s");
+    : graph_(&graph), overlay_(&overlay), profile_(std::move(vehicle)) {
+  if (!(profile_.vmax_mps > 0.0) || !std::isfinite(profile_.vmax_mps)) {
+    throw CostUpdateError("vehicle max speed must be a positive number, got " + std::to_string(profile_.vmax_mps) + " m/s");
   }
   validate(profile_);
   if (overlay.edge_count() != graph.edge_count() || overlay.node_count() != graph.node_count()) {
     throw CostUpdateError("cost overlay was built for another graph");
   }
-  restriction_modes_ = profile_.restriction_modes;
   scaled_speeds_ = std::any_of(profile_.speed_factor.begin(), profile_.speed_factor.end(), [](double f) { return f != 1.0; });
   // A turn of θ costs turn_penalty × (1 − cos θ) / 2: nothing straight on, half at a right angle,
   // all of it turning back. A turn of more than 30° towards the side of oncoming traffic (left where

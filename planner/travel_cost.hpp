@@ -41,7 +41,7 @@ class TravelCost {
     if (!blocked_.empty() && blocked_[e.index()] != 0) return kInfCost;
     double speed = graph_->speed_mps(e);
     if (scaled_speeds_) speed *= profile_.speed_factor[static_cast<std::size_t>(graph_->road_class(e))];
-    const double free_flow = graph_->length_m(e) / std::min(speed, vmax_mps_);
+    const double free_flow = graph_->length_m(e) / std::min(speed, profile_.vmax_mps);
     return free_flow * std::max(overlay_->edge(e).congestion_factor, 1.0);
   }
   [[nodiscard]] double edge_time_s(EdgeId e) const { return add_cost(running_time_s(e), overlay_->edge(e).queue_delay_s); }
@@ -57,8 +57,8 @@ class TravelCost {
   // oncoming traffic. Never negative, so free flow stays a lower bound.
   [[nodiscard]] double turn_s(const maps::TurnArc& a) const {
     if (a.plain()) return angle_cost_s_[static_cast<std::size_t>(a.angle_deg + 180)];
-    if ((a.ban_modes() & restriction_modes_) != 0 ||
-        (!profile_.emergency_exceptions && (a.ban_modes_except_emergency() & restriction_modes_) != 0)) {
+    if ((a.ban_modes() & profile_.restriction_modes) != 0 ||
+        (!profile_.emergency_exceptions && (a.ban_modes_except_emergency() & profile_.restriction_modes) != 0)) {
       return kInfCost;
     }
     if (a.uturn()) {
@@ -84,7 +84,7 @@ class TravelCost {
 
   [[nodiscard]] const maps::RoadGraph& graph() const { return *graph_; }
   [[nodiscard]] const CostOverlay& overlay() const { return *overlay_; }
-  [[nodiscard]] double vmax_mps() const { return vmax_mps_; }
+  [[nodiscard]] double vmax_mps() const { return profile_.vmax_mps; }
   [[nodiscard]] const VehicleProfile& profile() const { return profile_; }
   // True when the vehicle does not fit on e.
   [[nodiscard]] bool blocked(EdgeId e) const { return !blocked_.empty() && blocked_[e.index()] != 0; }
@@ -93,8 +93,6 @@ class TravelCost {
   const maps::RoadGraph* graph_;
   const CostOverlay* overlay_;
   VehicleProfile profile_;
-  double vmax_mps_;
-  std::uint8_t restriction_modes_;
   bool scaled_speeds_;
   std::array<double, 361> angle_cost_s_{};  // by signed angle + 180
   std::vector<std::uint8_t> blocked_;      // by edge; empty when no limit binds the vehicle
