@@ -6,6 +6,9 @@
 // moves it by the drift the odometry accumulated, which the output's sigma_m said to expect.
 #pragma once
 
+#include <deque>
+#include <optional>
+
 #include "localizer/fusion/odometry_map_matcher.hpp"
 #include "localizer/match/hmm_matcher.hpp"
 
@@ -16,6 +19,11 @@ struct LocalizerConfig {
   OdometryMatchConfig odometry;
   double max_gps_hdop = 10.0;   // the seed's switch
   double gps_timeout_s = 2.5;   // no good fix for this long: odometry
+  double course_memory_m = 300.0;  // a remembered course counts until the odometry has driven this far
+  // Along the road, GPS is averaged over the last fixes, each carried forward by the odometry
+  // driven since (a stopped vehicle's fixes scatter along its road by σ; their mean by σ/√n).
+  std::size_t along_fixes = 10;
+  double along_drift_per_m = 0.01;  // the odometry's 1σ per metre carried
 };
 
 enum class PositionSource { none, gps, odometry };
@@ -44,12 +52,25 @@ class GpsOdometryLocalizer {
  private:
   LocalizedPoint output(PositionSource source, const MatchedPoint& m, double sigma_m);
   [[nodiscard]] double road_heading_deg(EdgeId e, double offset_m) const;
+  [[nodiscard]] MatchedPoint along_road_mean(const MatchedPoint& m, double sigma_m);
 
   const maps::RoadGraph& graph_;
   LocalizerConfig config_;
   HmmMatcher hmm_;
   OdometryMapMatcher odometry_;
   double last_good_gps_s_ = -1e18;
+  // The last course over ground seen while moving, turned since by the odometry: a vehicle that
+  // stopped keeps facing the way it drove, though the road alone cannot say which way that was.
+  std::optional<double> course_deg_;
+  double driven_since_course_m_ = 0;
+  double odometry_m_ = 0;  // every metre the odometry reported
+  struct RecentFix {
+    EdgeId edge;
+    double offset_m = 0;
+    double odometry_m = 0;  // odometry_m_ when it came
+    double sigma_m = 0;
+  };
+  std::deque<RecentFix> recent_;
   LocalizedPoint last_;
 };
 

@@ -1,17 +1,33 @@
 // Odometry map matching for when GPS is poor or absent (Parra Alonso et al., the seed paper
-// 001_25af06b4c534220d, §IV): relative motion (distance driven, heading change) is integrated in
-// the graph's local metric frame from the last good fix and its heading, and kept on the road:
-// the vehicle advances along its edge, and at a junction the turn-or-straight decision compares
-// the odometry's heading with each exit's bearing over the first metres past the junction (a
-// short curve-to-curve match). The uncertainty grows with distance; a heading that disagrees with
-// the road by more than 20° raises it by 20%; a turn sharper than 50° resets it to the map, since
-// the junction where the turn happened is a known place.
+// 001_25af06b4c534220d, §IV), kept as several hypotheses on the road graph instead of one.
+//
+// Relative motion (distance driven, heading change) is integrated in the graph's local metric
+// frame from the last good fix: a dead-reckoned curve. Each hypothesis is a place on the road that
+// the vehicle may have reached by driving that distance from one of the start candidates (the §IV
+// confidence region around the last good fix), with the curve turned to fit its start road. Its
+// start pays for its distance from the fix and for that turn against the fix's heading (whose 1σ
+// is wide when only a road's bearing gave it: a vehicle that was stopped may face either way). A
+// hypothesis branches into every exit at a junction, and pays per metre for how far its road
+// departs from the odometry:
+// - the curve-to-curve term: the angle between its road and the odometry's heading there;
+// - the point-to-curve term: its distance from its dead-reckoned position, against a 1σ that grows
+//   with the distance driven since its last reset.
+// Hypotheses far behind the best are pruned; equal places merge. One wrong committed exit at a
+// fork of two near-parallel streets no longer costs the whole outage: the other branch lives until
+// the streets part.
+//
+// §IV's tracking rules, per hypothesis: the 1σ grows with the distance driven; a heading that
+// disagrees with the road by more than 20° over the last 5 s raises it by 20%; a turn sharper than
+// 50° at a junction where the odometry turned too is a known place, so the along-road drift resets
+// there, and the hypothesis is moved along its road to where the odometry's turn was.
 #pragma once
 
 #include <deque>
+#include <optional>
 #include <vector>
 
 #include "localizer/match/gps_fix.hpp"
+#include "maps/edge_snapper.hpp"
 #include "maps/road_graph.hpp"
 
 namespace corridor::localizer {
@@ -29,45 +45,111 @@ struct OdometryMatchConfig {
   double disagreement_deg = 20.0;    // heading vs road beyond this raises the uncertainty...
   double disagreement_raise = 1.2;   // ...by this factor (once per second of disagreement)
   double heading_window_s = 5.0;     // the heading check looks this far back
-  double decision_m = 20.0;          // a junction's exit is decided over this many metres past it
   double reset_turn_deg = 50.0;      // a turn sharper than this resets the drift to the map
+  double turn_window_m = 40.0;       // the odometry's turn is looked for this far either side of the junction
+
+  // The hypotheses.
+  std::size_t max_hypotheses = 24;
+  double start_radius_m = 25.0;      // start candidates within max(this, 2σ of the last fix)
+  double heading_sigma_deg = 15.0;   // curve to curve: cost (angle/σ)²/2 per 10 m...
+  double heading_cap_deg = 60.0;     // ...the angle capped here (a turn's lag costs both branches alike)
+  double position_base_m = 5.0;      // point to curve: 1σ of the dead-reckoned position at the start...
+  double position_drift_per_m = 0.03;  // ...growing this much per metre driven
+  double position_cap = 8.0;         // per 10 m, so one bad stretch cannot outweigh the heading
+  double prune_margin = 25.0;        // cost behind the best beyond which a hypothesis is dropped
+  // Each hypothesis slowly aligns the odometry with its road (a complementary filter): the heading
+  // over this many metres of straight road, the dead-reckoned position over that many. The start's
+  // heading can be off by a GPS course's error, and 15° puts the curve on the parallel street
+  // after 80 m; the slow position pull keeps the point-to-curve term about the recent drive.
+  double heading_align_m = 50.0;
+  double position_align_m = 300.0;
+  double merge_m = 2.0;              // two hypotheses this close on one edge are one
+};
+
+// Where the odometry starts: the last good fix, matched.
+struct OdometryStart {
+  EdgeId edge;              // the matched edge...
+  double offset_m = 0;      // ...and offset
+  maps::Point2 point;       // the matched point (the dead reckoning's origin)
+  double heading_deg = 0;   // the vehicle's heading there...
+  double heading_sigma_deg = 20.0;  // ...and its 1σ (a receiver's course: small; a road's bearing alone: large)
+  double time_s = 0;
+  double sigma_m = 5.0;     // 1σ of the fix
 };
 
 class OdometryMapMatcher {
  public:
-  OdometryMapMatcher(const maps::RoadGraph& graph, OdometryMatchConfig config = {});
+  // The snapper finds the start candidates around the last good fix; without one, only the
+  // matched edge (and its twin) start.
+  explicit OdometryMapMatcher(const maps::RoadGraph& graph, OdometryMatchConfig config = {},
+                              const maps::EdgeSnapper* snapper = nullptr);
 
-  // Starts from a point on the road (a matched GPS fix) with the vehicle's heading there.
+  // Starts from a point on the road (a matched GPS fix) with the vehicle's heading there. Cheap:
+  // the hypotheses are made when the odometry is first advanced.
+  void start(const OdometryStart& from);
   void start(EdgeId edge, double offset_m, double heading_deg, double time_s, double sigma_m);
-  [[nodiscard]] bool started() const { return edge_.valid(); }
+  [[nodiscard]] bool started() const { return start_.edge.valid(); }
 
-  // Advances by one increment and returns the map-constrained position (unmatched if not started).
+  // Records an increment without moving the hypotheses (while GPS is still followed): they are
+  // made and driven through every recorded increment when advance() is first called.
+  void record(const OdometryStep& step);
+  // Advances by one increment and returns the best hypothesis's position (unmatched if not started).
   MatchedPoint advance(const OdometryStep& step);
+  // A poor fix (HDOP over the switch's limit) still weighs the hypotheses, with its own large 1σ.
+  void observe(maps::Point2 fix, double sigma_m);
 
-  [[nodiscard]] double sigma_m() const { return sigma_m_; }
+  [[nodiscard]] double sigma_m() const;
   [[nodiscard]] double heading_deg() const { return heading_deg_; }
-  [[nodiscard]] std::size_t resets() const { return resets_; }
+  [[nodiscard]] std::size_t resets() const;
+  [[nodiscard]] std::size_t hypotheses() const { return hyps_.size(); }
 
  private:
+  struct Hypothesis {
+    EdgeId edge;
+    double offset_m = 0;
+    double cost = 0;
+    double sigma_m = 0;
+    // The odometry's frame as this hypothesis sees it: the heading offset that aligned the vehicle
+    // with its start road, and the dead-reckoned position from where its drift was last reset.
+    double heading_bias_deg = 0;
+    maps::Point2 reckoned;
+    double reckoned_from_m = 0;
+    double last_raise_s = -1e18;
+    std::size_t resets = 0;
+    // The last junction passed: the odometry distance there and the road's turn through it.
+    double junction_s = -1e18;
+    double junction_turn_deg = 0;
+    bool junction_checked = true;
+  };
+  struct Pending {
+    OdometryStep step;
+    std::optional<maps::Point2> fix;
+    double fix_sigma_m = 0;
+  };
+
   [[nodiscard]] double road_bearing_deg(EdgeId e, double offset_m) const;
+  void seed();
+  void drive(double distance_m, double turn_deg);
+  void move(Hypothesis h, double left_m, std::vector<Hypothesis>& out) const;
+  void score(double distance_m);
+  void reset_at_turns();
+  void heading_check(double time_s);
+  void prune();
   [[nodiscard]] MatchedPoint current() const;
-  void decide_exit();
+  [[nodiscard]] double heading_at(double s) const;
 
   const maps::RoadGraph& graph_;
   OdometryMatchConfig config_;
-  EdgeId edge_;
-  double offset_m_ = 0;
+  const maps::EdgeSnapper* snapper_;
+  OdometryStart start_;
+  std::vector<Pending> pending_;
+  std::vector<Hypothesis> hyps_;
+  std::vector<Hypothesis> scratch_;
+  bool seeded_ = false;
   double heading_deg_ = 0;  // integrated odometry heading in the map frame
-  double sigma_m_ = 0;
-  double last_time_s_ = 0;
-  double last_raise_s_ = -1e18;
-  std::size_t resets_ = 0;
-  // A junction passed within decision_m: the exits still in play and the edge we came from.
-  std::vector<EdgeId> exits_;
-  EdgeId came_from_;
-  double past_junction_m_ = 0;
-  double heading_at_junction_deg_ = 0;
+  double driven_m_ = 0;     // since the start
   std::deque<std::pair<double, double>> headings_;  // (time, heading) over the heading window
+  std::deque<std::pair<double, double>> track_;     // (driven, heading) over the turn window
 };
 
 }  // namespace corridor::localizer

@@ -45,6 +45,7 @@ struct FcdParser {
     s.position = {std::strtod(y, nullptr), std::strtod(x, nullptr)};
     if (const char* a = attr(attrs, "angle")) s.heading_deg = std::strtod(a, nullptr);
     if (const char* v = attr(attrs, "speed")) s.speed_mps = std::strtod(v, nullptr);
+    if (const char* l = attr(attrs, "lane")) s.lane = l;
     if (maps::is_valid_lat_lon(s.position)) vehicles[id].push_back(s);
   }
 

@@ -16,6 +16,7 @@ struct TruthSample {
   maps::LatLon position;
   double heading_deg = 0;  // SUMO's angle: clockwise from north
   double speed_mps = 0;
+  std::string lane;  // SUMO's lane id ("<edge>_<index>", ":<junction>_…" inside a junction), if given
 };
 
 // Vehicle id -> its samples in time order. Only ids starting with `prefix` (all when empty).

@@ -3,17 +3,13 @@
 #include "localizer/match/bearing.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <numbers>
 #include <random>
 #include <sstream>
 
 namespace corridor::localizer {
-namespace {
-
-
-}  // namespace
-
 EdgeId true_edge(const maps::RoadGraph& g, const maps::EdgeSnapper& snapper, maps::Point2 p, double heading_deg,
                  double radius_m) {
   EdgeId best;
@@ -28,11 +24,63 @@ EdgeId true_edge(const maps::RoadGraph& g, const maps::EdgeSnapper& snapper, map
   return best;
 }
 
-namespace {
+std::optional<std::int64_t> sumo_lane_osm_way(const std::string& lane) {
+  // "[-]<digits>[#<digits>]_<digits>": netconvert's name for a part of an OSM way, one direction.
+  std::size_t i = lane.size() > 0 && lane[0] == '-' ? 1 : 0;
+  const std::size_t digits = i;
+  while (i < lane.size() && std::isdigit(static_cast<unsigned char>(lane[i])) != 0) ++i;
+  if (i == digits || i - digits > 18) return std::nullopt;
+  const std::int64_t way = std::stoll(lane.substr(digits, i - digits));
+  if (i < lane.size() && lane[i] == '#') {
+    const std::size_t part = ++i;
+    while (i < lane.size() && std::isdigit(static_cast<unsigned char>(lane[i])) != 0) ++i;
+    if (i == part) return std::nullopt;
+  }
+  if (i >= lane.size() || lane[i] != '_') return std::nullopt;
+  const std::size_t index = ++i;
+  while (i < lane.size() && std::isdigit(static_cast<unsigned char>(lane[i])) != 0) ++i;
+  if (i == index || i != lane.size()) return std::nullopt;
+  return way;
+}
 
-bool same_road(const maps::RoadGraph& g, EdgeId a, EdgeId b) { return a == b || (a.valid() && g.twin(a) == b); }
-
-}  // namespace
+std::vector<TrueEdges> true_edges(const maps::RoadGraph& g, const maps::EdgeSnapper& snapper,
+                                  const std::vector<TruthSample>& samples, double radius_m) {
+  std::vector<TrueEdges> out(samples.size());
+  std::vector<std::uint8_t> in_junction(samples.size(), 0);
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const TruthSample& s = samples[i];
+    const maps::Point2 p = g.projection().to_local(s.position);
+    if (!s.lane.empty() && s.lane[0] == ':') {
+      in_junction[i] = 1;
+      continue;
+    }
+    if (const auto way = sumo_lane_osm_way(s.lane)) {
+      double best_d = 1e18;
+      for (const maps::SnapResult& r : snapper.candidates_local(p, radius_m, 16)) {
+        for (auto [e, off] : {std::pair{r.edge, r.offset_m}, std::pair{r.twin, r.twin_offset_m}}) {
+          if (!e.valid() || g.osm_way(e).v != *way) continue;
+          if (angle_between_deg(road_bearing_deg(g, e, off, 3.0), s.heading_deg) > 90.0) continue;
+          if (r.distance_m < best_d) out[i].edge = e, best_d = r.distance_m;
+        }
+      }
+    }
+    if (!out[i].edge.valid()) out[i].edge = true_edge(g, snapper, p, s.heading_deg, radius_m);
+  }
+  // Inside a junction: the edge the vehicle came by, or the one it leaves by.
+  EdgeId before;
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    if (in_junction[i] == 0) {
+      before = out[i].edge;
+      continue;
+    }
+    std::size_t j = i;
+    while (j < samples.size() && in_junction[j] != 0) ++j;
+    const EdgeId after = j < samples.size() ? out[j].edge : EdgeId{};
+    out[i].edge = before.valid() ? before : after;
+    out[i].alt = after;
+  }
+  return out;
+}
 
 StudyResult run_localization_study(const maps::RoadGraph& g, const maps::EdgeSnapper& snapper,
                                    const std::map<std::string, std::vector<TruthSample>>& drives, const StudyConfig& config,
@@ -103,12 +151,15 @@ StudyResult run_localization_study(const maps::RoadGraph& g, const maps::EdgeSna
     }
 
     // Scores.
+    const std::vector<TrueEdges> truths = true_edges(g, snapper, samples, config.truth_radius_m);
     std::vector<std::uint8_t> on_track(samples.size(), 0);
     for (std::size_t i = 0; i < samples.size(); ++i) {
       const double step_m = i > 0 ? maps::distance_m(truth[i - 1], truth[i]) : 0.0;
       d.length_m += step_m;
       const bool out_now = samples[i].time_s >= outage_begin && samples[i].time_s < outage_end;
-      const EdgeId truth_edge = true_edge(g, snapper, truth[i], samples[i].heading_deg, config.truth_radius_m);
+      const TrueEdges& t = truths[i];
+      const EdgeId nearest_oracle = true_edge(g, snapper, truth[i], samples[i].heading_deg, config.truth_radius_m);
+      auto on_road = [&](EdgeId e) { return t.contains(e) || (e.valid() && t.contains(g.twin(e))); };
       if (!out_now) {
         const maps::Point2 raw = g.projection().to_local(gps[std::lower_bound(gps_sample.begin(), gps_sample.end(), i) - gps_sample.begin()].position);
         d.sq_raw += std::pow(maps::distance_m(raw, truth[i]), 2);
@@ -119,26 +170,29 @@ StudyResult run_localization_study(const maps::RoadGraph& g, const maps::EdgeSna
           d.sq_hmm += std::pow(maps::distance_m(hmm_at[i].point, truth[i]), 2);
           ++d.n_hmm;
         }
-        if (truth_edge.valid()) {
+        if (t.valid()) {
           ++d.with_truth;
           d.length_with_truth += step_m;
-          d.correct_nearest_road += same_road(g, near.edge, truth_edge) ? 1 : 0;
-          if (hmm_at[i].matched && hmm_at[i].edge == truth_edge) {
+          d.correct_nearest_road += on_road(near.edge) ? 1 : 0;
+          if (hmm_at[i].matched && t.contains(hmm_at[i].edge)) {
             ++d.correct_hmm;
             d.length_correct_hmm += step_m;
           }
-          d.correct_hmm_road += hmm_at[i].matched && same_road(g, hmm_at[i].edge, truth_edge) ? 1 : 0;
+          d.correct_hmm_road += hmm_at[i].matched && on_road(hmm_at[i].edge) ? 1 : 0;
+          d.correct_hmm_nearest_oracle += hmm_at[i].matched && hmm_at[i].edge == nearest_oracle ? 1 : 0;
         }
       }
       if (fused[i].match.matched) {
         d.sq_fused += std::pow(maps::distance_m(fused[i].match.point, truth[i]), 2);
         ++d.n_fused;
       }
-      const bool fused_correct = fused[i].match.matched && truth_edge.valid() && fused[i].match.edge == truth_edge;
-      if (truth_edge.valid() && !out_now) d.correct_fused += fused_correct ? 1 : 0;
-      if (out_now && truth_edge.valid()) {
+      const bool fused_correct = fused[i].match.matched && t.contains(fused[i].match.edge);
+      if (t.valid() && !out_now) d.correct_fused += fused_correct ? 1 : 0;
+      if (!samples[i].lane.empty() && sumo_lane_osm_way(samples[i].lane)) ++d.truth_from_lane;
+      if (out_now && t.valid()) {
         ++d.outage_samples;
         d.outage_correct += fused_correct ? 1 : 0;
+        d.outage_correct_nearest_oracle += fused[i].match.matched && fused[i].match.edge == nearest_oracle ? 1 : 0;
         if (fused[i].match.matched) d.outage_sq += std::pow(maps::distance_m(fused[i].match.point, truth[i]), 2);
       }
       on_track[i] = fused_correct && maps::distance_m(fused[i].match.point, truth[i]) < 15.0 ? 1 : 0;
@@ -171,6 +225,9 @@ StudyResult run_localization_study(const maps::RoadGraph& g, const maps::EdgeSna
     t.correct_hmm_road += d.correct_hmm_road, t.correct_fused += d.correct_fused;
     t.length_with_truth += d.length_with_truth, t.length_correct_hmm += d.length_correct_hmm;
     t.outage_samples += d.outage_samples, t.outage_correct += d.outage_correct, t.outage_sq += d.outage_sq;
+    t.correct_hmm_nearest_oracle += d.correct_hmm_nearest_oracle;
+    t.outage_correct_nearest_oracle += d.outage_correct_nearest_oracle;
+    t.truth_from_lane += d.truth_from_lane;
     t.recovery_s = std::max(t.recovery_s, d.recovery_s);
     t.handback_jump_m = std::max(t.handback_jump_m, d.handback_jump_m);
   }

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,9 @@ struct DriveResult {
   double length_with_truth = 0, length_correct_hmm = 0;
   // The outage.
   std::size_t outage_samples = 0, outage_correct = 0;
+  // The same shares judged by the nearest-road oracle alone (true_edge below), for comparison.
+  std::size_t correct_hmm_nearest_oracle = 0, outage_correct_nearest_oracle = 0;
+  std::size_t truth_from_lane = 0;  // samples whose true edge came from SUMO's lane
   double outage_sq = 0;
   double recovery_s = 0;    // after the outage: until the fused estimate is on the true edge again
   double handback_jump_m = 0;  // how far the position moved when GPS came back
@@ -63,6 +67,26 @@ StudyResult run_localization_study(const maps::RoadGraph& graph, const maps::Edg
 // within radius_m whose direction agrees with the heading within 60°; invalid if none.
 EdgeId true_edge(const maps::RoadGraph& graph, const maps::EdgeSnapper& snapper, maps::Point2 p, double heading_deg,
                  double radius_m);
+
+// The OSM way of a SUMO lane id, as netconvert names edges after ways ("[-]<way>[#<part>]_<lane>");
+// nothing for a lane inside a junction (":…") or an edge netconvert made up.
+std::optional<std::int64_t> sumo_lane_osm_way(const std::string& lane);
+
+// What a sample's vehicle truly drives: one edge, or, inside a SUMO junction, either of the edges
+// before and after it (the vehicle is between them).
+struct TrueEdges {
+  EdgeId edge;
+  EdgeId alt;
+  [[nodiscard]] bool valid() const { return edge.valid(); }
+  [[nodiscard]] bool contains(EdgeId e) const { return e.valid() && (e == edge || e == alt); }
+};
+
+// The true edges of a drive. A sample on a lane of OSM way W: the nearest edge of W within
+// radius_m whose direction agrees with the heading within 90°, so a parallel road or a lane
+// offset cannot fool it; inside a junction: the edges before and after it; otherwise (no lane, or
+// no edge of W near) true_edge().
+std::vector<TrueEdges> true_edges(const maps::RoadGraph& graph, const maps::EdgeSnapper& snapper,
+                                  const std::vector<TruthSample>& samples, double radius_m);
 
 // An SVG of one drive: truth, raw GPS dots, HMM-matched and fused tracks, the outage highlighted,
 // over the roads near it.

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "localizer/fusion/gps_odometry_localizer.hpp"
+#include "localizer/study/localization_study.hpp"
 #include "tests/localizer/sketch_graph.hpp"
 
 namespace corridor::localizer {
@@ -115,6 +116,127 @@ TEST(GpsOdometryLocalizer, SwitchesToOdometryOnPoorGpsAndBackWithoutAJump) {
   const LocalizedPoint back = loc.on_gps(fix(20.0, x, 1.0));
   EXPECT_EQ(back.source, PositionSource::gps);
   EXPECT_LT(maps::distance_m(back.match.point, during.back().match.point), 15.0);
+}
+
+
+// A fork of two streets 4° apart (north-east of the junction at 88° and 92°): 150 m on, the left
+// one bends to 45°, the right one runs on. The vehicle takes the left one, but its odometry's
+// heading is 5° off from the start (a GPS course's error), so at the fork it points down the
+// right one. One committed exit stays on the wrong street; the hypotheses keep both until the
+// bend tells them apart.
+TEST(OdometryMapMatcher, KeepsBothStreetsOfANarrowForkUntilTheyPart) {
+  Sketch s;
+  const double r = 3.14159265358979 / 180.0;
+  auto at = [&](double bearing_deg, double from_x, double from_y, double len) {
+    return maps::Point2{from_x + len * std::sin(bearing_deg * r), from_y + len * std::cos(bearing_deg * r)};
+  };
+  const maps::Point2 left_bend = at(88.0, 0, 0, 150.0);
+  const maps::Point2 left_end = at(45.0, left_bend.x_m, left_bend.y_m, 200.0);
+  const maps::Point2 right_mid = at(92.0, 0, 0, 150.0);
+  const maps::Point2 right_end = at(92.0, 0, 0, 350.0);
+  s.nodes = {{-200, 0}, {0, 0}, left_bend, left_end, right_mid, right_end};
+  s.roads = {{{0, 1}, false, 1}, {{1, 2, 3}, false, 2}, {{1, 4, 5}, false, 3}};
+  const auto g = s.build();
+  OdometryMapMatcher m(g);
+  m.start(edge_between(g, {-200, 0}, {0, 0}), 195.0, 95.0, 0.0, 5.0);  // truly 90°, 5 m before the fork
+  MatchedPoint p;
+  double driven = 0.0;
+  for (int t = 1; t <= 30; ++t) {
+    driven += 10.0;
+    double turn = 0.0;
+    if (driven > 0.0 && driven <= 10.0) turn = -2.0;      // onto the left street (90° -> 88°)
+    if (driven > 155.0 && driven <= 175.0) turn = -21.5;  // its bend, over 20 m
+    p = m.advance({static_cast<double>(t), 10.0, turn});
+  }
+  ASSERT_TRUE(p.matched);
+  EXPECT_EQ(p.edge, edge_between(g, left_bend, left_end));
+  EXPECT_LT(maps::distance_m(p.point, at(45.0, left_bend.x_m, left_bend.y_m, 135.0)), 15.0);
+}
+
+// A stopped vehicle's heading came from the road alone, and the road ran the other way: the
+// hypothesis facing back lives on, and wins when the vehicle turns where only it can.
+TEST(OdometryMapMatcher, AVehicleFacingTheOtherWayIsFoundByItsTurn) {
+  Sketch s;
+  // West-east road from (-200,0) to (0,0); at its east end a road north, at its west end a road
+  // north too: eastbound that is a left turn, westbound a right turn.
+  s.nodes = {{-200, 0}, {0, 0}, {0, 200}, {-200, 200}};
+  s.roads = {{{0, 1}, false, 1}, {{1, 2}, false, 2}, {{0, 3}, false, 3}};
+  const auto g = s.build();
+  OdometryMapMatcher m(g);
+  OdometryStart from;
+  from.edge = edge_between(g, {-200, 0}, {0, 0});
+  from.offset_m = 100.0;
+  from.point = {-100, 0};
+  from.heading_deg = 90.0;         // the road's eastbound bearing...
+  from.heading_sigma_deg = 45.0;   // ...and nothing better known
+  m.start(from);
+  MatchedPoint p;
+  double driven = 0.0;
+  for (int t = 1; t <= 20; ++t) {
+    driven += 10.0;
+    const double turn = driven > 95.0 && driven <= 115.0 ? 45.0 : 0.0;  // a right turn, 100 m on
+    p = m.advance({static_cast<double>(t), 10.0, turn});
+  }
+  ASSERT_TRUE(p.matched);
+  EXPECT_EQ(p.edge, edge_between(g, {-200, 0}, {-200, 200}));
+}
+
+// A vehicle stopped 100 m west of the crossroads: its fixes scatter along the road by ±8 m, and
+// the localizer's position along the road is their mean, not the last one.
+TEST(GpsOdometryLocalizer, AveragesAStoppedVehiclesFixesAlongTheRoad) {
+  const auto g = crossroads();
+  const maps::EdgeSnapper snapper(g);
+  GpsOdometryLocalizer loc(g, snapper);
+  const double scatter[] = {8.0, -6.0, 5.0, -7.0, 6.0, -4.0, 7.0, -8.0, 4.0, 6.0};
+  LocalizedPoint p;
+  for (int t = 0; t < 10; ++t) {
+    if (t > 0) loc.on_odometry({static_cast<double>(t), 0.0, 0.0});
+    GpsFix f;
+    f.time_s = t;
+    f.position = g.projection().to_lat_lon({-100.0 + scatter[t], 1.0});
+    f.hdop = 1.5;
+    p = loc.on_gps(f);
+  }
+  ASSERT_EQ(p.source, PositionSource::gps);
+  EXPECT_LT(std::abs(p.match.point.x_m - (-100.0)), 2.0);  // the last fix alone is 6 m off
+}
+
+TEST(LocalizationStudy, ReadsTheOsmWayOfASumoLane) {
+  EXPECT_EQ(sumo_lane_osm_way("93209286#3_0"), 93209286);
+  EXPECT_EQ(sumo_lane_osm_way("-93209286#12_1"), 93209286);
+  EXPECT_EQ(sumo_lane_osm_way("4230011_0"), 4230011);
+  EXPECT_FALSE(sumo_lane_osm_way(":cluster_1_0_0"));
+  EXPECT_FALSE(sumo_lane_osm_way("93137621#0-AddedOnRampEdge_1"));
+  EXPECT_FALSE(sumo_lane_osm_way("93209286#3"));
+  EXPECT_FALSE(sumo_lane_osm_way(""));
+}
+
+// The oracle: a lane of way 1 names that way's edge even where way 3 runs nearer, and inside a
+// junction either the edge before it or the one after it is the truth.
+TEST(LocalizationStudy, TrueEdgesFollowTheLaneWayAndSpanAJunction) {
+  Sketch s;
+  // Way 1 west-east into the junction (0,0), way 2 on to the east; way 3 a parallel street 4 m
+  // north of way 1, joined to the junction by way 4.
+  s.nodes = {{-300, 0}, {0, 0}, {300, 0}, {-300, 4}, {-10, 4}};
+  s.roads = {{{0, 1}, false, 1}, {{1, 2}, false, 2}, {{3, 4}, false, 3}, {{4, 1}, false, 4}};
+  const auto g = s.build();
+  const maps::EdgeSnapper snapper(g);
+  auto sample = [&](double x, double y, const char* lane) {
+    TruthSample t;
+    t.position = g.projection().to_lat_lon({x, y});
+    t.heading_deg = 90.0;
+    t.lane = lane;
+    return t;
+  };
+  const std::vector<TruthSample> drive = {sample(-100, 3.5, "1_0"), sample(-1, 0, ":J_0_0"), sample(100, 0, "2_0"),
+                                          sample(-50, 3.9, "")};
+  const auto truth = true_edges(g, snapper, drive, 20.0);
+  const EdgeId way1 = edge_between(g, {-300, 0}, {0, 0}), way2 = edge_between(g, {0, 0}, {300, 0});
+  EXPECT_EQ(truth[0].edge, way1);  // nearer to way 3, but on way 1's lane
+  EXPECT_TRUE(truth[1].contains(way1));
+  EXPECT_TRUE(truth[1].contains(way2));
+  EXPECT_EQ(truth[2].edge, way2);
+  EXPECT_EQ(truth[3].edge, edge_between(g, {-300, 4}, {-10, 4}));  // no lane: the nearest road
 }
 
 }  // namespace
