@@ -54,17 +54,28 @@ std::vector<TrueEdges> true_edges(const maps::RoadGraph& g, const maps::EdgeSnap
       in_junction[i] = 1;
       continue;
     }
+    // The nearest road going the vehicle's way (true_edge's rule)...
+    const auto candidates = snapper.candidates_local(p, radius_m, 16);
+    double nearest_d = radius_m;
+    for (const maps::SnapResult& r : candidates) {
+      for (auto [e, off] : {std::pair{r.edge, r.offset_m}, std::pair{r.twin, r.twin_offset_m}}) {
+        if (!e.valid() || angle_between_deg(road_bearing_deg(g, e, off, 3.0), s.heading_deg) > 60.0) continue;
+        if (r.distance_m < nearest_d) out[i].edge = e, nearest_d = r.distance_m;
+      }
+    }
+    // ...unless the lane's way has an edge here: its nearest, if not well beyond that road.
+    // netconvert joins consecutive ways into one edge (--geometry.remove), and its lane then
+    // names only the way where that edge starts.
     if (const auto way = sumo_lane_osm_way(s.lane)) {
-      double best_d = 1e18;
-      for (const maps::SnapResult& r : snapper.candidates_local(p, radius_m, 16)) {
+      double best_d = nearest_d + 4.0;
+      for (const maps::SnapResult& r : candidates) {
         for (auto [e, off] : {std::pair{r.edge, r.offset_m}, std::pair{r.twin, r.twin_offset_m}}) {
           if (!e.valid() || g.osm_way(e).v != *way) continue;
           if (angle_between_deg(road_bearing_deg(g, e, off, 3.0), s.heading_deg) > 90.0) continue;
-          if (r.distance_m < best_d) out[i].edge = e, best_d = r.distance_m;
+          if (r.distance_m <= best_d) out[i].edge = e, best_d = r.distance_m;
         }
       }
     }
-    if (!out[i].edge.valid()) out[i].edge = true_edge(g, snapper, p, s.heading_deg, radius_m);
   }
   // Inside a junction: the edge the vehicle came by, or the one it leaves by.
   EdgeId before;

@@ -81,10 +81,10 @@ struct TrueEdges {
   [[nodiscard]] bool contains(EdgeId e) const { return e.valid() && (e == edge || e == alt); }
 };
 
-// The true edges of a drive. A sample on a lane of OSM way W: the nearest edge of W within
-// radius_m whose direction agrees with the heading within 90°, so a parallel road or a lane
-// offset cannot fool it; inside a junction: the edges before and after it; otherwise (no lane, or
-// no edge of W near) true_edge().
+// The true edges of a drive. A sample on a lane of OSM way W: the nearest edge of W whose
+// direction agrees with the heading within 90°, so a parallel road or a lane offset cannot fool
+// it, if it lies within 4 m more than true_edge()'s road (else SUMO's edge spans ways, and that
+// road stands); inside a junction: the edges before and after it; otherwise true_edge().
 std::vector<TrueEdges> true_edges(const maps::RoadGraph& graph, const maps::EdgeSnapper& snapper,
                                   const std::vector<TruthSample>& samples, double radius_m);
 
