@@ -47,6 +47,7 @@ void OdometryMapMatcher::seed() {
   hyps_.clear();
   heading_deg_ = start_.heading_deg;
   driven_m_ = 0.0;
+  siblings_at_m_ = 0.0;
   headings_.assign(1, {start_.time_s, heading_deg_});
   track_.assign(1, {0.0, heading_deg_});
   const double sigma = std::max(start_.sigma_m, config_.base_sigma_m);
@@ -238,6 +239,21 @@ void OdometryMapMatcher::prune() {
   hyps_.swap(scratch_);
 }
 
+void OdometryMapMatcher::add_siblings() {
+  if (driven_m_ - siblings_at_m_ < config_.sibling_every_m) return;
+  siblings_at_m_ = driven_m_;
+  const std::size_t parents = std::min(config_.sibling_parents, hyps_.size());
+  for (std::size_t i = 0; i < parents; ++i) {
+    for (const double shift : {-config_.sibling_step_m, config_.sibling_step_m}) {
+      Hypothesis h = hyps_[i];
+      h.offset_m += shift;
+      if (h.offset_m < 0.0 || h.offset_m > graph_.length_m(h.edge)) continue;
+      h.cost += config_.sibling_cost;
+      hyps_.push_back(h);
+    }
+  }
+}
+
 void OdometryMapMatcher::observe(maps::Point2 fix, double sigma_m) {
   if (!started() || !(sigma_m > 0.0) || !std::isfinite(fix.x_m) || !std::isfinite(fix.y_m)) return;
   if (!seeded_) {
@@ -289,6 +305,8 @@ MatchedPoint OdometryMapMatcher::advance(const OdometryStep& step) {
     reset_at_turns();
   }
   heading_check(step.time_s);
+  prune();
+  add_siblings();
   prune();
   return current();
 }

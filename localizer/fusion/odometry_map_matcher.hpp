@@ -63,6 +63,13 @@ struct OdometryMatchConfig {
   // after 80 m; the slow position pull keeps the point-to-curve term about the recent drive.
   double heading_align_m = 50.0;
   double position_align_m = 300.0;
+  // The along-road drift between sharp turns (a scale error, a road drawn shorter than driven):
+  // every so many metres the best hypotheses put out siblings a few metres ahead and behind, and
+  // the road's bends pick the one that fits.
+  double sibling_every_m = 20.0;
+  double sibling_step_m = 3.0;
+  double sibling_cost = 1.0;
+  std::size_t sibling_parents = 3;
   double merge_m = 2.0;              // two hypotheses this close on one edge are one
 };
 
@@ -135,6 +142,7 @@ class OdometryMapMatcher {
   void reset_at_turns();
   void heading_check(double time_s);
   void prune();
+  void add_siblings();
   [[nodiscard]] MatchedPoint current() const;
   [[nodiscard]] double heading_at(double s) const;
 
@@ -148,6 +156,7 @@ class OdometryMapMatcher {
   bool seeded_ = false;
   double heading_deg_ = 0;  // integrated odometry heading in the map frame
   double driven_m_ = 0;     // since the start
+  double siblings_at_m_ = 0;
   std::deque<std::pair<double, double>> headings_;  // (time, heading) over the heading window
   std::deque<std::pair<double, double>> track_;     // (driven, heading) over the turn window
 };

@@ -153,6 +153,35 @@ TEST(OdometryMapMatcher, KeepsBothStreetsOfANarrowForkUntilTheyPart) {
   EXPECT_LT(maps::distance_m(p.point, at(45.0, left_bend.x_m, left_bend.y_m, 135.0)), 15.0);
 }
 
+// The odometry reads 2% short (a scale error), so along a 300 m street the position falls 6 m
+// behind. A 40° bend is too gentle for the drift reset, but the hypotheses put out siblings ahead
+// and behind, and the bend picks one that fits better: 100 m past it (2 m more of drift), the
+// position is 5 m short instead of 8.
+TEST(OdometryMapMatcher, ABendTakesOutTheAlongRoadDrift) {
+  Sketch s;
+  const double r = 3.14159265358979 / 180.0;
+  const maps::Point2 bend{300, 0};
+  const maps::Point2 end{300 + 200 * std::sin(130 * r), 200 * std::cos(130 * r)};
+  s.nodes = {{0, 0}, bend, end};
+  s.roads = {{{0, 1}, false, 1}, {{1, 2}, false, 2}};
+  const auto g = s.build();
+  OdometryMapMatcher m(g);
+  m.start(edge_between(g, {0, 0}, bend), 0.0, 90.0, 0.0, 3.0);
+  MatchedPoint p;
+  double truly = 0.0;
+  for (int t = 1; t <= 200; ++t) {  // 2 m steps, as a visual odometry at 10 Hz gives them
+    const double before = truly;
+    truly += 2.0;
+    // The 40° turn is made over the 10 m from 295 to 305 m (truly driven).
+    const double turn = 40.0 * std::max(0.0, std::min(truly, 305.0) - std::max(before, 295.0)) / 10.0;
+    p = m.advance({0.2 * t, 2.0 * 0.98, turn});
+  }
+  ASSERT_TRUE(p.matched);
+  const maps::Point2 truth{bend.x_m + 100 * std::sin(130 * r), bend.y_m + 100 * std::cos(130 * r)};
+  EXPECT_EQ(p.edge, edge_between(g, bend, end));
+  EXPECT_LT(maps::distance_m(p.point, truth), 5.5);  // 8 m short without the siblings
+}
+
 // A stopped vehicle's heading came from the road alone, and the road ran the other way: the
 // hypothesis facing back lives on, and wins when the vehicle turns where only it can.
 TEST(OdometryMapMatcher, AVehicleFacingTheOtherWayIsFoundByItsTurn) {
