@@ -170,9 +170,10 @@ json drive_json(const localizer::DriveResult& d) {
           {"outage_correct_edge_share", ratio(static_cast<double>(d.outage_correct), static_cast<double>(d.outage_samples))},
           {"outage_rmse_m", rmse(d.outage_sq, d.outage_samples)},
           // The same shares against the nearest-road oracle alone (no SUMO lane), for comparison.
-          {"correct_edge_hmm_by_time_nearest_oracle", ratio(static_cast<double>(d.correct_hmm_nearest_oracle), truth)},
+          {"correct_edge_hmm_by_time_nearest_oracle",
+           ratio(static_cast<double>(d.correct_hmm_nearest_oracle), static_cast<double>(d.with_truth_nearest_oracle))},
           {"outage_correct_edge_share_nearest_oracle",
-           ratio(static_cast<double>(d.outage_correct_nearest_oracle), static_cast<double>(d.outage_samples))},
+           ratio(static_cast<double>(d.outage_correct_nearest_oracle), static_cast<double>(d.outage_samples_nearest_oracle))},
           {"truth_from_lane_share", ratio(static_cast<double>(d.truth_from_lane), static_cast<double>(d.samples))},
           {"recovery_s", d.recovery_s},
           {"handback_jump_m", d.handback_jump_m}};

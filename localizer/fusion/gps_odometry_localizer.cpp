@@ -38,11 +38,15 @@ LocalizedPoint GpsOdometryLocalizer::output(PositionSource source, const Matched
   return p;
 }
 
-MatchedPoint GpsOdometryLocalizer::along_road_mean(const MatchedPoint& m, double sigma_m) {
+MatchedPoint GpsOdometryLocalizer::along_road_mean(const MatchedPoint& m, double sigma_m, double time_s) {
   // The GPS/odometry fusion along the road: each recent fix on this edge (either way), or on the
   // edge just before it, is carried forward by the odometry driven since, and the estimates are averaged
   // with weights for the fix's σ and the odometry's drift. Across the road, the match stands.
-  recent_.push_back({m.edge, m.offset_m, odometry_m_, sigma_m});
+  // Only what the odometry carried: without it (a GPS-only trace, a VO dropout), or after a gap
+  // in the fixes, the older fixes would hold a moving vehicle back.
+  const bool carried_by_odometry = time_s - last_odometry_s_ <= config_.gps_timeout_s;
+  if (!carried_by_odometry || (!recent_.empty() && time_s - recent_.back().time_s > config_.gps_timeout_s)) recent_.clear();
+  recent_.push_back({m.edge, m.offset_m, odometry_m_, sigma_m, time_s});
   while (recent_.size() > config_.along_fixes) recent_.pop_front();
   EdgeId before;  // the edge that leads into m.edge, if a recent fix was on it
   for (const RecentFix& r : recent_) {
@@ -55,22 +59,24 @@ MatchedPoint GpsOdometryLocalizer::along_road_mean(const MatchedPoint& m, double
     if (r.edge == m.edge) {
       u = r.offset_m;
     } else if (r.edge == graph_.twin(m.edge)) {
-      u = graph_.length_m(m.edge) - r.offset_m;  // a stopped vehicle's match may face either way
+      // A stopped vehicle's match may face either way (and the two ways may differ in length).
+      u = graph_.length_m(m.edge) * (1.0 - r.offset_m / std::max(graph_.length_m(r.edge), 1e-9));
     } else if (before.valid() && r.edge == before) {
       u = r.offset_m - before_len;
     } else {
       continue;
     }
     const double carried = odometry_m_ - r.odometry_m;
+    if (carried > config_.along_max_carry_m) continue;
     const double estimate = u + carried;
-    const double var = r.sigma_m * r.sigma_m + std::pow(config_.along_drift_per_m * carried, 2.0);
+    const double var = std::max(0.25, r.sigma_m * r.sigma_m + std::pow(config_.along_drift_per_m * carried, 2.0));
     // A fix far from this one along the road (a multipath jump the matcher followed) is left out.
     if (std::abs(estimate - m.offset_m) > 3.0 * std::max(sigma_m, r.sigma_m)) continue;
     sum += estimate / var;
     weights += 1.0 / var;
   }
-  if (weights <= 0.0) return m;
-  const double u = sum / weights;
+  const double u = weights > 0.0 ? sum / weights : m.offset_m;
+  if (!std::isfinite(u)) return m;
   MatchedPoint out = m;
   if (u >= 0.0 || !before.valid()) {
     out.offset_m = std::clamp(u, 0.0, graph_.length_m(m.edge));
@@ -87,14 +93,18 @@ LocalizedPoint GpsOdometryLocalizer::on_gps(const GpsFix& fix) {
   if (fix.hdop && *fix.hdop > config_.max_gps_hdop) {
     // Not followed (the seed's switch), but a poor fix still tells the odometry's hypotheses apart
     // when they are streets apart.
-    odometry_.observe(graph_.projection().to_local(fix.position), *fix.hdop * config_.hmm.sigma_base_m);
+    if (maps::is_valid_lat_lon(fix.position)) {
+      odometry_.observe(graph_.projection().to_local(fix.position), *fix.hdop * config_.hmm.sigma_base_m);
+    }
     return last_;
   }
   const MatchedPoint matched = hmm_.update(fix);
   if (!matched.matched) return last_;
   last_good_gps_s_ = fix.time_s;
-  const double sigma = fix.hdop.value_or(config_.hmm.default_hdop) * config_.hmm.sigma_base_m;
-  const MatchedPoint m = along_road_mean(matched, sigma);
+  // An HDOP that is missing, zero or not a number counts as the default, as in the matcher.
+  const double hdop = fix.hdop && std::isfinite(*fix.hdop) && *fix.hdop > 0.0 ? *fix.hdop : config_.hmm.default_hdop;
+  const double sigma = hdop * config_.hmm.sigma_base_m;
+  const MatchedPoint m = along_road_mean(matched, sigma, fix.time_s);
   // Odometry always restarts from the latest good fix, so a hand-over continues from it. Its
   // heading is the receiver's last course while moving, turned by the odometry since (the online
   // match's direction can be wrong at the last fix, and a stopped vehicle has no course); without
@@ -124,6 +134,7 @@ LocalizedPoint GpsOdometryLocalizer::on_gps(const GpsFix& fix) {
 
 LocalizedPoint GpsOdometryLocalizer::on_odometry(const OdometryStep& step) {
   if (std::isfinite(step.distance_m)) odometry_m_ += std::max(0.0, step.distance_m);
+  if (std::isfinite(step.time_s)) last_odometry_s_ = step.time_s;
   if (course_deg_ && std::isfinite(step.heading_change_deg) && std::isfinite(step.distance_m)) {
     course_deg_ = wrap180(*course_deg_ + step.heading_change_deg);
     driven_since_course_m_ += std::max(0.0, step.distance_m);

@@ -23,7 +23,8 @@ struct LocalizerConfig {
   // Along the road, GPS is averaged over the last fixes, each carried forward by the odometry
   // driven since (a stopped vehicle's fixes scatter along its road by σ; their mean by σ/√n).
   std::size_t along_fixes = 10;
-  double along_drift_per_m = 0.01;  // the odometry's 1σ per metre carried
+  double along_drift_per_m = 0.01;  // the odometry's 1σ per metre carried...
+  double along_max_carry_m = 150.0;  // ...and no further than this
 };
 
 enum class PositionSource { none, gps, odometry };
@@ -52,7 +53,7 @@ class GpsOdometryLocalizer {
  private:
   LocalizedPoint output(PositionSource source, const MatchedPoint& m, double sigma_m);
   [[nodiscard]] double road_heading_deg(EdgeId e, double offset_m) const;
-  [[nodiscard]] MatchedPoint along_road_mean(const MatchedPoint& m, double sigma_m);
+  [[nodiscard]] MatchedPoint along_road_mean(const MatchedPoint& m, double sigma_m, double time_s);
 
   const maps::RoadGraph& graph_;
   LocalizerConfig config_;
@@ -64,11 +65,13 @@ class GpsOdometryLocalizer {
   std::optional<double> course_deg_;
   double driven_since_course_m_ = 0;
   double odometry_m_ = 0;  // every metre the odometry reported
+  double last_odometry_s_ = -1e18;  // when it last reported
   struct RecentFix {
     EdgeId edge;
     double offset_m = 0;
     double odometry_m = 0;  // odometry_m_ when it came
     double sigma_m = 0;
+    double time_s = 0;
   };
   std::deque<RecentFix> recent_;
   LocalizedPoint last_;

@@ -10,8 +10,9 @@ namespace corridor::localizer {
 namespace {
 
 constexpr double kDegToRad = std::numbers::pi / 180.0;
-constexpr int kMaxJunctionsPerStep = 24;  // zero-length edges must not branch forever
-constexpr std::size_t kMaxBranches = 4096;
+constexpr int kMaxJunctionsPerStep = 24;  // a long step over very short edges must not branch forever
+constexpr std::size_t kMaxBranches = 4096;  // per hypothesis and step
+constexpr std::size_t kMaxHistory = 512;   // heading samples kept, whatever the odometry's rate
 
 }  // namespace
 
@@ -25,7 +26,19 @@ double OdometryMapMatcher::road_bearing_deg(EdgeId e, double offset_m) const {
 
 void OdometryMapMatcher::start(const OdometryStart& from) {
   start_ = from;
-  if (start_.edge.valid()) start_.offset_m = std::clamp(start_.offset_m, 0.0, graph_.length_m(start_.edge));
+  if (start_.edge.valid()) {
+    // Whatever a caller passes, the hypotheses start from finite numbers on the road.
+    const double len = graph_.length_m(start_.edge);
+    start_.offset_m = std::isfinite(start_.offset_m) ? std::clamp(start_.offset_m, 0.0, len) : 0.0;
+    if (!std::isfinite(start_.point.x_m) || !std::isfinite(start_.point.y_m)) start_.point = graph_.point_along(start_.edge, start_.offset_m);
+    if (!std::isfinite(start_.heading_deg)) {
+      start_.heading_deg = road_bearing_deg(start_.edge, start_.offset_m);
+      start_.heading_sigma_deg = 45.0;
+    }
+    if (!(start_.heading_sigma_deg > 0.0) || !std::isfinite(start_.heading_sigma_deg)) start_.heading_sigma_deg = 45.0;
+    if (!(start_.sigma_m > 0.0) || !std::isfinite(start_.sigma_m)) start_.sigma_m = config_.base_sigma_m;
+    if (!std::isfinite(start_.time_s)) start_.time_s = 0.0;
+  }
   pending_.clear();
   hyps_.clear();
   seeded_ = false;
@@ -73,7 +86,10 @@ void OdometryMapMatcher::seed() {
     hyps_.push_back(h);
   };
   add(start_.edge, start_.offset_m, 0.0);
-  add(graph_.twin(start_.edge), graph_.length_m(start_.edge) - start_.offset_m, 0.0);
+  if (const EdgeId twin = graph_.twin(start_.edge); twin.valid()) {
+    // (The two directions of a road may differ in length, as in a SUMO net.)
+    add(twin, graph_.length_m(twin) * (1.0 - start_.offset_m / std::max(graph_.length_m(start_.edge), 1e-9)), 0.0);
+  }
   if (snapper_ != nullptr) {
     const double radius = std::max(config_.start_radius_m, 2.0 * sigma);
     for (const maps::SnapResult& c : snapper_->candidates_local(start_.point, radius, 8)) {
@@ -93,11 +109,13 @@ void OdometryMapMatcher::move(Hypothesis h, double left_m, std::vector<Hypothesi
     int junctions;
   };
   std::vector<Frame> stack{{h, left_m, 0}};
+  const std::size_t out_before = out.size();
   while (!stack.empty()) {
     Frame f = stack.back();
     stack.pop_back();
     const double len = graph_.length_m(f.h.edge);
-    if (f.left <= len - f.h.offset_m || f.junctions >= kMaxJunctionsPerStep || out.size() + stack.size() >= kMaxBranches) {
+    if (f.left <= len - f.h.offset_m || f.junctions >= kMaxJunctionsPerStep ||
+        out.size() - out_before + stack.size() >= kMaxBranches) {
       f.h.offset_m = std::min(len, f.h.offset_m + f.left);
       out.push_back(f.h);
       continue;
@@ -114,8 +132,12 @@ void OdometryMapMatcher::move(Hypothesis h, double left_m, std::vector<Hypothesi
         next.edge = e;
         next.offset_m = 0.0;
         next.junction_s = driven_m_ - rest;
-        next.junction_turn_deg = wrap180(road_bearing_deg(e, 0.0) - bearing_in);
-        next.junction_checked = std::abs(next.junction_turn_deg) <= config_.reset_turn_deg;
+        const double road_turn = wrap180(road_bearing_deg(e, 0.0) - bearing_in);
+        if (std::abs(road_turn) > config_.reset_turn_deg) {
+          next.sharp_s = next.junction_s;
+          next.sharp_turn_deg = road_turn;
+          next.sharp_pending = true;
+        }
         stack.push_back({next, rest, f.junctions + 1});
         any = true;
       }
@@ -178,22 +200,22 @@ void OdometryMapMatcher::reset_at_turns() {
   // its road by the difference, and restart its along-road uncertainty.
   const double half = config_.turn_window_m / 2.0;
   for (Hypothesis& h : hyps_) {
-    if (h.junction_checked || driven_m_ - h.junction_s < half) continue;
-    h.junction_checked = true;
-    const double before = heading_at(h.junction_s - config_.turn_window_m);
+    if (!h.sharp_pending || driven_m_ - h.sharp_s < half) continue;
+    h.sharp_pending = false;
+    const double before = heading_at(h.sharp_s - config_.turn_window_m);
     // (Turns are differences, so this hypothesis's heading offset cancels out.)
     const double turn = wrap180(heading_deg_ - before);
-    if (std::abs(turn) <= config_.reset_turn_deg || angle_between_deg(turn, h.junction_turn_deg) > 30.0) continue;
-    double s_mid = h.junction_s;
+    if (std::abs(turn) <= config_.reset_turn_deg || angle_between_deg(turn, h.sharp_turn_deg) > 30.0) continue;
+    double s_mid = h.sharp_s;
     for (const auto& [d, heading] : track_) {
-      if (d < h.junction_s - config_.turn_window_m) continue;
+      if (d < h.sharp_s - config_.turn_window_m) continue;
       if (std::abs(wrap180(heading - before)) >= std::abs(turn) / 2.0) {
         s_mid = d;
         break;
       }
     }
-    const double moved = h.offset_m + (h.junction_s - s_mid);
-    if (moved < 0.0 || moved > graph_.length_m(h.edge)) continue;
+    const double moved = h.offset_m + (h.sharp_s - s_mid);
+    if (!(moved >= 0.0 && moved <= graph_.length_m(h.edge))) continue;
     h.offset_m = moved;
     h.sigma_m = config_.base_sigma_m;
     ++h.resets;
@@ -294,17 +316,25 @@ MatchedPoint OdometryMapMatcher::advance(const OdometryStep& step) {
   const double turn = std::isfinite(step.heading_change_deg) ? step.heading_change_deg : 0.0;
   heading_deg_ = wrap180(heading_deg_ + turn);
   driven_m_ += dist;
-  headings_.emplace_back(step.time_s, heading_deg_);
-  while (headings_.size() > 1 && headings_.front().first < step.time_s - config_.heading_window_s) headings_.pop_front();
-  track_.emplace_back(driven_m_, heading_deg_);
-  while (track_.size() > 2 && track_[1].first < driven_m_ - 3.0 * config_.turn_window_m) track_.pop_front();
+  const double time_s = std::isfinite(step.time_s) ? step.time_s : headings_.back().first;
+  headings_.emplace_back(time_s, heading_deg_);
+  while (headings_.size() > kMaxHistory || (headings_.size() > 1 && headings_.front().first < time_s - config_.heading_window_s)) {
+    headings_.pop_front();
+  }
+  // Standing still adds nothing to the curve: the last sample takes the new heading.
+  if (dist > 0.0 || track_.size() < 2) {
+    track_.emplace_back(driven_m_, heading_deg_);
+  } else {
+    track_.back().second = heading_deg_;
+  }
+  while (track_.size() > kMaxHistory || (track_.size() > 2 && track_[1].first < driven_m_ - 3.0 * config_.turn_window_m)) track_.pop_front();
 
   if (dist > 0.0) {
     drive(dist, turn);
     score(dist);
     reset_at_turns();
   }
-  heading_check(step.time_s);
+  heading_check(time_s);
   prune();
   add_siblings();
   prune();

@@ -46,7 +46,7 @@ struct OdometryMatchConfig {
   double disagreement_raise = 1.2;   // ...by this factor (once per second of disagreement)
   double heading_window_s = 5.0;     // the heading check looks this far back
   double reset_turn_deg = 50.0;      // a turn sharper than this resets the drift to the map
-  double turn_window_m = 40.0;       // the odometry's turn is looked for this far either side of the junction
+  double turn_window_m = 40.0;       // the odometry's turn is looked for from this far before a sharp junction, once half as far past it
 
   // The hypotheses.
   std::size_t max_hypotheses = 24;
@@ -97,8 +97,9 @@ class OdometryMapMatcher {
   void start(EdgeId edge, double offset_m, double heading_deg, double time_s, double sigma_m);
   [[nodiscard]] bool started() const { return start_.edge.valid(); }
 
-  // Records an increment without moving the hypotheses (while GPS is still followed): they are
-  // made and driven through every recorded increment when advance() is first called.
+  // Records an increment while GPS is still followed: before the hypotheses exist it is only
+  // kept, and they are made and driven through every kept increment when advance() is first
+  // called; once they exist, it advances them.
   void record(const OdometryStep& step);
   // Advances by one increment and returns the best hypothesis's position (unmatched if not started).
   MatchedPoint advance(const OdometryStep& step);
@@ -123,10 +124,13 @@ class OdometryMapMatcher {
     double reckoned_from_m = 0;
     double last_raise_s = -1e18;
     std::size_t resets = 0;
-    // The last junction passed: the odometry distance there and the road's turn through it.
+    // The odometry distance at the last node passed; and the last sharp turn of the road at a
+    // node, with its distance and angle, until the drift reset has checked it (another node
+    // soon after, where two ways meet, must not take its place).
     double junction_s = -1e18;
-    double junction_turn_deg = 0;
-    bool junction_checked = true;
+    double sharp_s = -1e18;
+    double sharp_turn_deg = 0;
+    bool sharp_pending = false;
   };
   struct Pending {
     OdometryStep step;
@@ -154,7 +158,7 @@ class OdometryMapMatcher {
   std::vector<Hypothesis> hyps_;
   std::vector<Hypothesis> scratch_;
   bool seeded_ = false;
-  double heading_deg_ = 0;  // integrated odometry heading in the map frame
+  double heading_deg_ = 0;  // integrated odometry heading from the start's (a hypothesis adds its bias)
   double driven_m_ = 0;     // since the start
   double siblings_at_m_ = 0;
   std::deque<std::pair<double, double>> headings_;  // (time, heading) over the heading window

@@ -72,7 +72,7 @@ std::vector<TrueEdges> true_edges(const maps::RoadGraph& g, const maps::EdgeSnap
         for (auto [e, off] : {std::pair{r.edge, r.offset_m}, std::pair{r.twin, r.twin_offset_m}}) {
           if (!e.valid() || g.osm_way(e).v != *way) continue;
           if (angle_between_deg(road_bearing_deg(g, e, off, 3.0), s.heading_deg) > 90.0) continue;
-          if (r.distance_m <= best_d) out[i].edge = e, best_d = r.distance_m;
+          if (r.distance_m <= best_d) out[i].edge = e, out[i].from_lane = true, best_d = r.distance_m;
         }
       }
     }
@@ -190,6 +190,9 @@ StudyResult run_localization_study(const maps::RoadGraph& g, const maps::EdgeSna
             d.length_correct_hmm += step_m;
           }
           d.correct_hmm_road += hmm_at[i].matched && on_road(hmm_at[i].edge) ? 1 : 0;
+        }
+        if (nearest_oracle.valid()) {
+          ++d.with_truth_nearest_oracle;
           d.correct_hmm_nearest_oracle += hmm_at[i].matched && hmm_at[i].edge == nearest_oracle ? 1 : 0;
         }
       }
@@ -199,11 +202,14 @@ StudyResult run_localization_study(const maps::RoadGraph& g, const maps::EdgeSna
       }
       const bool fused_correct = fused[i].match.matched && t.contains(fused[i].match.edge);
       if (t.valid() && !out_now) d.correct_fused += fused_correct ? 1 : 0;
-      if (!samples[i].lane.empty() && sumo_lane_osm_way(samples[i].lane)) ++d.truth_from_lane;
+      d.truth_from_lane += t.from_lane ? 1 : 0;
+      if (out_now && nearest_oracle.valid()) {
+        ++d.outage_samples_nearest_oracle;
+        d.outage_correct_nearest_oracle += fused[i].match.matched && fused[i].match.edge == nearest_oracle ? 1 : 0;
+      }
       if (out_now && t.valid()) {
         ++d.outage_samples;
         d.outage_correct += fused_correct ? 1 : 0;
-        d.outage_correct_nearest_oracle += fused[i].match.matched && fused[i].match.edge == nearest_oracle ? 1 : 0;
         if (fused[i].match.matched) d.outage_sq += std::pow(maps::distance_m(fused[i].match.point, truth[i]), 2);
       }
       on_track[i] = fused_correct && maps::distance_m(fused[i].match.point, truth[i]) < 15.0 ? 1 : 0;
@@ -236,7 +242,8 @@ StudyResult run_localization_study(const maps::RoadGraph& g, const maps::EdgeSna
     t.correct_hmm_road += d.correct_hmm_road, t.correct_fused += d.correct_fused;
     t.length_with_truth += d.length_with_truth, t.length_correct_hmm += d.length_correct_hmm;
     t.outage_samples += d.outage_samples, t.outage_correct += d.outage_correct, t.outage_sq += d.outage_sq;
-    t.correct_hmm_nearest_oracle += d.correct_hmm_nearest_oracle;
+    t.with_truth_nearest_oracle += d.with_truth_nearest_oracle, t.correct_hmm_nearest_oracle += d.correct_hmm_nearest_oracle;
+    t.outage_samples_nearest_oracle += d.outage_samples_nearest_oracle;
     t.outage_correct_nearest_oracle += d.outage_correct_nearest_oracle;
     t.truth_from_lane += d.truth_from_lane;
     t.recovery_s = std::max(t.recovery_s, d.recovery_s);

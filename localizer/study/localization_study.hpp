@@ -40,9 +40,11 @@ struct DriveResult {
   double length_with_truth = 0, length_correct_hmm = 0;
   // The outage.
   std::size_t outage_samples = 0, outage_correct = 0;
-  // The same shares judged by the nearest-road oracle alone (true_edge below), for comparison.
-  std::size_t correct_hmm_nearest_oracle = 0, outage_correct_nearest_oracle = 0;
-  std::size_t truth_from_lane = 0;  // samples whose true edge came from SUMO's lane
+  // The same shares judged by the nearest-road oracle alone (true_edge below), over the samples
+  // it has a truth for, for comparison.
+  std::size_t with_truth_nearest_oracle = 0, correct_hmm_nearest_oracle = 0;
+  std::size_t outage_samples_nearest_oracle = 0, outage_correct_nearest_oracle = 0;
+  std::size_t truth_from_lane = 0;  // samples whose true edge the lane's way chose (junctions apart)
   double outage_sq = 0;
   double recovery_s = 0;    // after the outage: until the fused estimate is on the true edge again
   double handback_jump_m = 0;  // how far the position moved when GPS came back
@@ -77,6 +79,7 @@ std::optional<std::int64_t> sumo_lane_osm_way(const std::string& lane);
 struct TrueEdges {
   EdgeId edge;
   EdgeId alt;
+  bool from_lane = false;  // the lane's way chose `edge`
   [[nodiscard]] bool valid() const { return edge.valid(); }
   [[nodiscard]] bool contains(EdgeId e) const { return e.valid() && (e == edge || e == alt); }
 };

@@ -1,6 +1,9 @@
 // Odometry map matching (Parra Alonso §IV) and the GPS/odometry switch on HDOP, on a crossroads.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+
 #include "localizer/fusion/gps_odometry_localizer.hpp"
 #include "localizer/study/localization_study.hpp"
 #include "tests/localizer/sketch_graph.hpp"
@@ -144,7 +147,7 @@ TEST(OdometryMapMatcher, KeepsBothStreetsOfANarrowForkUntilTheyPart) {
   for (int t = 1; t <= 30; ++t) {
     driven += 10.0;
     double turn = 0.0;
-    if (driven > 0.0 && driven <= 10.0) turn = -2.0;      // onto the left street (90° -> 88°)
+    if (driven <= 10.0) turn = -2.0;                      // onto the left street (90° -> 88°)
     if (driven > 155.0 && driven <= 175.0) turn = -21.5;  // its bend, over 20 m
     p = m.advance({static_cast<double>(t), 10.0, turn});
   }
@@ -180,6 +183,56 @@ TEST(OdometryMapMatcher, ABendTakesOutTheAlongRoadDrift) {
   const maps::Point2 truth{bend.x_m + 100 * std::sin(130 * r), bend.y_m + 100 * std::cos(130 * r)};
   EXPECT_EQ(p.edge, edge_between(g, bend, end));
   EXPECT_LT(maps::distance_m(p.point, truth), 5.5);  // 8 m short without the siblings
+}
+
+// Two ways meet 10 m after a sharp turn (a node where nothing turns): the turn still resets the
+// drift.
+TEST(OdometryMapMatcher, ANodeRightAfterASharpTurnDoesNotHideIt) {
+  Sketch s;
+  s.nodes = {{-300, 0}, {0, 0}, {300, 0}, {0, -10}, {0, -300}};
+  s.roads = {{{0, 1, 2}, false, 1}, {{1, 3}, false, 2}, {{3, 4}, false, 3}};
+  const auto g = s.build();
+  OdometryMapMatcher m(g);
+  EXPECT_EQ(drive(g, m, 90.0).first, edge_between(g, {0, -10}, {0, -300}));
+  EXPECT_EQ(m.resets(), 1u);
+}
+
+// A fix with HDOP 0 (a receiver's placeholder) or none at all still gives a finite position,
+// and the odometry that starts from it stays finite.
+TEST(GpsOdometryLocalizer, AZeroHdopIsTheDefaultNotADivisionByZero) {
+  const auto g = crossroads();
+  const maps::EdgeSnapper snapper(g);
+  GpsOdometryLocalizer loc(g, snapper);
+  LocalizedPoint p;
+  for (int t = 0; t < 5; ++t) {
+    if (t > 0) loc.on_odometry({static_cast<double>(t), 10.0, 0.0});
+    GpsFix f;
+    f.time_s = t;
+    f.position = g.projection().to_lat_lon({-200.0 + 10.0 * t, 1.0});
+    f.hdop = t % 2 == 0 ? 0.0 : std::numeric_limits<double>::quiet_NaN();
+    p = loc.on_gps(f);
+    ASSERT_TRUE(std::isfinite(p.match.offset_m) && std::isfinite(p.match.point.x_m)) << "fix " << t;
+  }
+  for (int t = 5; t < 12; ++t) p = loc.on_odometry({static_cast<double>(t), 10.0, 0.0});
+  ASSERT_EQ(p.source, PositionSource::odometry);
+  EXPECT_NEAR(p.match.point.x_m, -200.0 + 10.0 * 11, 5.0);
+}
+
+// GPS alone, no odometry: the averaging along the road must not hold a moving vehicle back at
+// where its older fixes were.
+TEST(GpsOdometryLocalizer, WithoutOdometryAMovingVehicleIsNotHeldBack) {
+  const auto g = crossroads();
+  const maps::EdgeSnapper snapper(g);
+  GpsOdometryLocalizer loc(g, snapper);
+  LocalizedPoint p;
+  for (int t = 0; t < 10; ++t) {
+    GpsFix f;
+    f.time_s = t;
+    f.position = g.projection().to_lat_lon({-250.0 + 15.0 * t, 1.0});
+    f.hdop = 2.0;  // σ 8 m: the older fixes would count if nothing carried them
+    p = loc.on_gps(f);
+  }
+  EXPECT_NEAR(p.match.point.x_m, -250.0 + 15.0 * 9, 1.0);
 }
 
 // A stopped vehicle's heading came from the road alone, and the road ran the other way: the
