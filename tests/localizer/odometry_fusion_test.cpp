@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "localizer/fusion/gps_odometry_localizer.hpp"
 #include "localizer/study/localization_study.hpp"
@@ -26,6 +27,24 @@ EdgeId edge_between(const maps::RoadGraph& g, maps::Point2 from, maps::Point2 to
     if (maps::distance_m(g.position(g.tail(e)), from) < 1.0 && maps::distance_m(g.position(g.head(e)), to) < 1.0) return e;
   }
   return EdgeId{};
+}
+
+// The localizer on the crossroads, for the tests of its GPS side.
+class LocalizerOnCrossroads : public ::testing::Test {
+ protected:
+  maps::RoadGraph g = crossroads();
+  maps::EdgeSnapper snapper{g};
+  GpsOdometryLocalizer loc{g, snapper};
+  LocalizedPoint p;
+};
+
+// A fix 1 m north of the east-west road, at x metres east of the crossroads.
+GpsFix fix_at(const maps::RoadGraph& g, double t, double x, std::optional<double> hdop) {
+  GpsFix f;
+  f.time_s = t;
+  f.position = g.projection().to_lat_lon({x, 1.0});
+  f.hdop = hdop;
+  return f;
 }
 
 // Drives 10 m a second from 150 m west of the junction, eastbound; `turn_deg` is spread over the
@@ -199,18 +218,10 @@ TEST(OdometryMapMatcher, ANodeRightAfterASharpTurnDoesNotHideIt) {
 
 // A fix with HDOP 0 (a receiver's placeholder) or none at all still gives a finite position,
 // and the odometry that starts from it stays finite.
-TEST(GpsOdometryLocalizer, AZeroHdopIsTheDefaultNotADivisionByZero) {
-  const auto g = crossroads();
-  const maps::EdgeSnapper snapper(g);
-  GpsOdometryLocalizer loc(g, snapper);
-  LocalizedPoint p;
+TEST_F(LocalizerOnCrossroads, AZeroHdopIsTheDefaultNotADivisionByZero) {
   for (int t = 0; t < 5; ++t) {
     if (t > 0) loc.on_odometry({static_cast<double>(t), 10.0, 0.0});
-    GpsFix f;
-    f.time_s = t;
-    f.position = g.projection().to_lat_lon({-200.0 + 10.0 * t, 1.0});
-    f.hdop = t % 2 == 0 ? 0.0 : std::numeric_limits<double>::quiet_NaN();
-    p = loc.on_gps(f);
+    p = loc.on_gps(fix_at(g, t, -200.0 + 10.0 * t, t % 2 == 0 ? 0.0 : std::numeric_limits<double>::quiet_NaN()));
     ASSERT_TRUE(std::isfinite(p.match.offset_m) && std::isfinite(p.match.point.x_m)) << "fix " << t;
   }
   for (int t = 5; t < 12; ++t) p = loc.on_odometry({static_cast<double>(t), 10.0, 0.0});
@@ -220,17 +231,9 @@ TEST(GpsOdometryLocalizer, AZeroHdopIsTheDefaultNotADivisionByZero) {
 
 // GPS alone, no odometry: the averaging along the road must not hold a moving vehicle back at
 // where its older fixes were.
-TEST(GpsOdometryLocalizer, WithoutOdometryAMovingVehicleIsNotHeldBack) {
-  const auto g = crossroads();
-  const maps::EdgeSnapper snapper(g);
-  GpsOdometryLocalizer loc(g, snapper);
-  LocalizedPoint p;
+TEST_F(LocalizerOnCrossroads, WithoutOdometryAMovingVehicleIsNotHeldBack) {
   for (int t = 0; t < 10; ++t) {
-    GpsFix f;
-    f.time_s = t;
-    f.position = g.projection().to_lat_lon({-250.0 + 15.0 * t, 1.0});
-    f.hdop = 2.0;  // σ 8 m: the older fixes would count if nothing carried them
-    p = loc.on_gps(f);
+    p = loc.on_gps(fix_at(g, t, -250.0 + 15.0 * t, 2.0));  // σ 8 m: older fixes would count if nothing carried them
   }
   EXPECT_NEAR(p.match.point.x_m, -250.0 + 15.0 * 9, 1.0);
 }
@@ -265,19 +268,11 @@ TEST(OdometryMapMatcher, AVehicleFacingTheOtherWayIsFoundByItsTurn) {
 
 // A vehicle stopped 100 m west of the crossroads: its fixes scatter along the road by ±8 m, and
 // the localizer's position along the road is their mean, not the last one.
-TEST(GpsOdometryLocalizer, AveragesAStoppedVehiclesFixesAlongTheRoad) {
-  const auto g = crossroads();
-  const maps::EdgeSnapper snapper(g);
-  GpsOdometryLocalizer loc(g, snapper);
+TEST_F(LocalizerOnCrossroads, AveragesAStoppedVehiclesFixesAlongTheRoad) {
   const double scatter[] = {8.0, -6.0, 5.0, -7.0, 6.0, -4.0, 7.0, -8.0, 4.0, 6.0};
-  LocalizedPoint p;
   for (int t = 0; t < 10; ++t) {
     if (t > 0) loc.on_odometry({static_cast<double>(t), 0.0, 0.0});
-    GpsFix f;
-    f.time_s = t;
-    f.position = g.projection().to_lat_lon({-100.0 + scatter[t], 1.0});
-    f.hdop = 1.5;
-    p = loc.on_gps(f);
+    p = loc.on_gps(fix_at(g, t, -100.0 + scatter[t], 1.5));
   }
   ASSERT_EQ(p.source, PositionSource::gps);
   EXPECT_LT(std::abs(p.match.point.x_m - (-100.0)), 2.0);  // the last fix alone is 6 m off
