@@ -101,9 +101,7 @@ LocalizedPoint GpsOdometryLocalizer::on_gps(const GpsFix& fix) {
   const MatchedPoint matched = hmm_.update(fix);
   if (!matched.matched) return last_;
   last_good_gps_s_ = fix.time_s;
-  // An HDOP that is missing, zero or not a number counts as the default, as in the matcher.
-  const double hdop = fix.hdop && std::isfinite(*fix.hdop) && *fix.hdop > 0.0 ? *fix.hdop : config_.hmm.default_hdop;
-  const double sigma = hdop * config_.hmm.sigma_base_m;
+  const double sigma = usable_hdop(fix, config_.hmm.default_hdop) * config_.hmm.sigma_base_m;
   const MatchedPoint m = along_road_mean(matched, sigma, fix.time_s);
   // Odometry always restarts from the latest good fix, so a hand-over continues from it. Its
   // heading is the receiver's last course while moving, turned by the odometry since (the online

@@ -2,6 +2,7 @@
 // the map matchers take and give.
 #pragma once
 
+#include <cmath>
 #include <optional>
 
 #include "maps/geo.hpp"
@@ -16,6 +17,12 @@ struct GpsFix {
   std::optional<double> heading_deg;  // course over ground, clockwise from north
   std::optional<double> speed_mps;
 };
+
+// The HDOP a matcher works with: the fix's, unless it is missing, zero, negative or not a number
+// (a receiver's placeholder), when `default_hdop` stands in. Every σ taken from a fix uses this.
+inline double usable_hdop(const GpsFix& fix, double default_hdop) {
+  return fix.hdop && std::isfinite(*fix.hdop) && *fix.hdop > 0.0 ? *fix.hdop : default_hdop;
+}
 
 struct MatchedPoint {
   bool matched = false;  // false: no road near, or the chain broke here and nothing fits yet

@@ -34,7 +34,7 @@ HmmMatcher::HmmMatcher(const maps::RoadGraph& graph, const maps::EdgeSnapper& sn
 void HmmMatcher::reset() { window_.clear(); }
 
 std::vector<HmmMatcher::Candidate> HmmMatcher::candidates_for(const GpsFix& fix, maps::Point2 raw) const {
-  const double hdop = fix.hdop && std::isfinite(*fix.hdop) && *fix.hdop > 0.0 ? *fix.hdop : config_.default_hdop;
+  const double hdop = usable_hdop(fix, config_.default_hdop);
   const double sigma = hdop * config_.sigma_base_m;
   const double radius = std::clamp(config_.radius_sigmas * sigma, config_.min_radius_m, config_.max_radius_m);
   const bool use_heading = fix.heading_deg && std::isfinite(*fix.heading_deg) &&
@@ -72,7 +72,7 @@ bool HmmMatcher::link(const Step& prev, Step& next, const GpsFix& fix, planner::
   const bool use_speed = fix.speed_mps && std::isfinite(*fix.speed_mps) && dt > 0.0;
   // Both distances come from noisy fixes (projected onto the road, or straight between them), so
   // their difference spreads with the GPS noise: the scale grows with σ, never below beta_m.
-  const double hdop = fix.hdop && std::isfinite(*fix.hdop) && *fix.hdop > 0.0 ? *fix.hdop : config_.default_hdop;
+  const double hdop = usable_hdop(fix, config_.default_hdop);
   const double beta = std::max(config_.beta_m, config_.beta_per_sigma * hdop * config_.sigma_base_m);
 
   // Best path score and parent per candidate, applied only if some candidate is reachable: a

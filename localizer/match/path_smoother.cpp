@@ -63,8 +63,7 @@ std::vector<MatchedPoint> smooth_along_path(const maps::RoadGraph& g, planner::B
   std::vector<Mat> pf(n), pp(n);
   const double q = config.acceleration_sigma * config.acceleration_sigma;
   auto sigma_s = [&](std::size_t i) {
-    const double h = fixes[i].hdop && *fixes[i].hdop > 0.0 ? *fixes[i].hdop : config.default_hdop;
-    return h * config.sigma_base_m;
+    return usable_hdop(fixes[i], config.default_hdop) * config.sigma_base_m;
   };
   const double v0 = fixes[0].speed_mps.value_or(n > 1 && fixes[1].time_s > fixes[0].time_s
                                                     ? (s[1] - s[0]) / (fixes[1].time_s - fixes[0].time_s)
