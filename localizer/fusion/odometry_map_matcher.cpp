@@ -165,7 +165,8 @@ void OdometryMapMatcher::score(double distance_m) {
   for (Hypothesis& h : hyps_) {
     h.sigma_m += config_.drift_per_m * distance_m;
     const double heading = heading_deg_ + h.heading_bias_deg;
-    const double ang = std::min(angle_between_deg(road_bearing_deg(h.edge, h.offset_m), heading), config_.heading_cap_deg);
+    const double road = road_bearing_deg(h.edge, h.offset_m);
+    const double ang = std::min(angle_between_deg(road, heading), config_.heading_cap_deg);
     h.cost += per * 0.5 * std::pow(ang / config_.heading_sigma_deg, 2.0);
     const double base = h.resets == 0 ? config_.position_base_m + 0.5 * start_.sigma_m : config_.position_base_m;
     const double position_sigma = base + config_.position_drift_per_m * (driven_m_ - h.reckoned_from_m);
@@ -174,7 +175,6 @@ void OdometryMapMatcher::score(double distance_m) {
     h.cost += per * std::min(config_.position_cap, 0.5 * std::pow(off / position_sigma, 2.0));
     // Align with the road where it runs straight, away from a junction's kinks; a larger
     // difference is a wrong road, not a misaligned odometry.
-    const double road = road_bearing_deg(h.edge, h.offset_m);
     const bool straight = angle_between_deg(road, road_bearing_deg(h.edge, std::max(0.0, h.offset_m - 10.0))) < 5.0;
     const double misaligned = wrap180(road - heading);
     if (straight && driven_m_ - h.junction_s > 15.0 && std::abs(misaligned) < 30.0) {
@@ -261,8 +261,8 @@ void OdometryMapMatcher::prune() {
   hyps_.swap(scratch_);
 }
 
-void OdometryMapMatcher::add_siblings() {
-  if (driven_m_ - siblings_at_m_ < config_.sibling_every_m) return;
+bool OdometryMapMatcher::add_siblings() {
+  if (driven_m_ - siblings_at_m_ < config_.sibling_every_m) return false;
   siblings_at_m_ = driven_m_;
   const std::size_t parents = std::min(config_.sibling_parents, hyps_.size());
   for (std::size_t i = 0; i < parents; ++i) {
@@ -274,6 +274,7 @@ void OdometryMapMatcher::add_siblings() {
       hyps_.push_back(h);
     }
   }
+  return parents > 0;
 }
 
 void OdometryMapMatcher::observe(maps::Point2 fix, double sigma_m) {
@@ -336,8 +337,7 @@ MatchedPoint OdometryMapMatcher::advance(const OdometryStep& step) {
   }
   heading_check(time_s);
   prune();
-  add_siblings();
-  prune();
+  if (add_siblings()) prune();  // they join behind their parents, and may merge with others
   return current();
 }
 

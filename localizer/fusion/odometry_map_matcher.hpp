@@ -146,7 +146,7 @@ class OdometryMapMatcher {
   void reset_at_turns();
   void heading_check(double time_s);
   void prune();
-  void add_siblings();
+  bool add_siblings();  // whether any were added
   [[nodiscard]] MatchedPoint current() const;
   [[nodiscard]] double heading_at(double s) const;
 
