@@ -10,18 +10,30 @@
 #include <sstream>
 
 namespace corridor::localizer {
-EdgeId true_edge(const maps::RoadGraph& g, const maps::EdgeSnapper& snapper, maps::Point2 p, double heading_deg,
-                 double radius_m) {
-  EdgeId best;
-  double best_d = 1e18;
-  for (const maps::SnapResult& r : snapper.candidates_local(p, radius_m, 8)) {
+namespace {
+
+// Among `candidates`, the nearest directed edge that `keep` accepts and whose bearing agrees with
+// the heading within max_deg, no farther than limit_m; with its distance.
+template <class Keep>
+std::pair<EdgeId, double> nearest_agreeing(const maps::RoadGraph& g, const std::vector<maps::SnapResult>& candidates,
+                                           double heading_deg, double max_deg, double limit_m, Keep keep) {
+  std::pair<EdgeId, double> best{EdgeId{}, limit_m};
+  for (const maps::SnapResult& r : candidates) {
     for (auto [e, off] : {std::pair{r.edge, r.offset_m}, std::pair{r.twin, r.twin_offset_m}}) {
-      if (!e.valid()) continue;
-      if (angle_between_deg(road_bearing_deg(g, e, off, 3.0), heading_deg) > 60.0) continue;
-      if (r.distance_m < best_d) best = e, best_d = r.distance_m;
+      if (!e.valid() || !keep(e) || angle_between_deg(road_bearing_deg(g, e, off, 3.0), heading_deg) > max_deg) continue;
+      if (r.distance_m <= best.second && (!best.first.valid() || r.distance_m < best.second)) best = {e, r.distance_m};
     }
   }
   return best;
+}
+
+constexpr auto kAnyEdge = [](EdgeId) { return true; };
+
+}  // namespace
+
+EdgeId true_edge(const maps::RoadGraph& g, const maps::EdgeSnapper& snapper, maps::Point2 p, double heading_deg,
+                 double radius_m) {
+  return nearest_agreeing(g, snapper.candidates_local(p, radius_m, 8), heading_deg, 60.0, radius_m, kAnyEdge).first;
 }
 
 std::optional<std::int64_t> sumo_lane_osm_way(const std::string& lane) {
@@ -50,31 +62,22 @@ std::vector<TrueEdges> true_edges(const maps::RoadGraph& g, const maps::EdgeSnap
   for (std::size_t i = 0; i < samples.size(); ++i) {
     const TruthSample& s = samples[i];
     const maps::Point2 p = g.projection().to_local(s.position);
+    const auto candidates = snapper.candidates_local(p, radius_m, 16);
+    // The nearest road going the vehicle's way (true_edge's rule), kept for comparison...
+    const auto [nearest, nearest_d] = nearest_agreeing(g, candidates, s.heading_deg, 60.0, radius_m, kAnyEdge);
+    out[i].nearest = nearest;
     if (!s.lane.empty() && s.lane[0] == ':') {
       in_junction[i] = 1;
       continue;
     }
-    // The nearest road going the vehicle's way (true_edge's rule)...
-    const auto candidates = snapper.candidates_local(p, radius_m, 16);
-    double nearest_d = radius_m;
-    for (const maps::SnapResult& r : candidates) {
-      for (auto [e, off] : {std::pair{r.edge, r.offset_m}, std::pair{r.twin, r.twin_offset_m}}) {
-        if (!e.valid() || angle_between_deg(road_bearing_deg(g, e, off, 3.0), s.heading_deg) > 60.0) continue;
-        if (r.distance_m < nearest_d) out[i].edge = e, nearest_d = r.distance_m;
-      }
-    }
+    out[i].edge = nearest;
     // ...unless the lane's way has an edge here: its nearest, if not well beyond that road.
     // netconvert joins consecutive ways into one edge (--geometry.remove), and its lane then
     // names only the way where that edge starts.
     if (const auto way = sumo_lane_osm_way(s.lane)) {
-      double best_d = nearest_d + 4.0;
-      for (const maps::SnapResult& r : candidates) {
-        for (auto [e, off] : {std::pair{r.edge, r.offset_m}, std::pair{r.twin, r.twin_offset_m}}) {
-          if (!e.valid() || g.osm_way(e).v != *way) continue;
-          if (angle_between_deg(road_bearing_deg(g, e, off, 3.0), s.heading_deg) > 90.0) continue;
-          if (r.distance_m <= best_d) out[i].edge = e, out[i].from_lane = true, best_d = r.distance_m;
-        }
-      }
+      const auto on_way = nearest_agreeing(g, candidates, s.heading_deg, 90.0, nearest_d + 4.0,
+                                           [&](EdgeId e) { return g.osm_way(e).v == *way; });
+      if (on_way.first.valid()) out[i].edge = on_way.first, out[i].from_lane = true;
     }
   }
   // Inside a junction: the edge the vehicle came by, or the one it leaves by.
@@ -169,7 +172,7 @@ StudyResult run_localization_study(const maps::RoadGraph& g, const maps::EdgeSna
       d.length_m += step_m;
       const bool out_now = samples[i].time_s >= outage_begin && samples[i].time_s < outage_end;
       const TrueEdges& t = truths[i];
-      const EdgeId nearest_oracle = true_edge(g, snapper, truth[i], samples[i].heading_deg, config.truth_radius_m);
+      const EdgeId nearest_oracle = t.nearest;
       auto on_road = [&](EdgeId e) { return t.contains(e) || (e.valid() && t.contains(g.twin(e))); };
       if (!out_now) {
         const maps::Point2 raw = g.projection().to_local(gps[std::lower_bound(gps_sample.begin(), gps_sample.end(), i) - gps_sample.begin()].position);

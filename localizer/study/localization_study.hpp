@@ -80,6 +80,7 @@ struct TrueEdges {
   EdgeId edge;
   EdgeId alt;
   bool from_lane = false;  // the lane's way chose `edge`
+  EdgeId nearest;          // what true_edge() alone would say, for comparison
   [[nodiscard]] bool valid() const { return edge.valid(); }
   [[nodiscard]] bool contains(EdgeId e) const { return e.valid() && (e == edge || e == alt); }
 };
