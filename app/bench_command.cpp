@@ -78,6 +78,8 @@ void register_bench_command(CLI::App& app) {
   replan->add_option("--min-trip-m", o->config.min_trip_m, "minimum straight-line trip length (0 = auto)");
   replan->add_option("--samples-csv", o->samples_csv, "also write one CSV row per replan (times, expansions)");
   replan->add_flag("!--no-dijkstra", o->config.run_dijkstra, "skip the Dijkstra baseline (and the mismatch check)");
+  replan->add_flag("--lazy-raises", o->config.lazy_raises,
+                   "D* Lite repairs cost increases only where they reach the path (Delayed D*), not at once");
   replan->callback([o] { run_replan(*o); });
 
   auto s = std::make_shared<std::pair<MapOptions, bench::ServeBenchConfig>>();

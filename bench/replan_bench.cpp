@@ -114,11 +114,11 @@ class UpdateGenerator {
 }  // namespace
 
 void write_samples_csv(std::ostream& out, const std::vector<ReplanSample>& samples) {
-  out << "trip,step,dstar_ms,astar_ms,dijkstra_ms,dstar_expanded,dstar_raised,astar_settled,route_edges_before,reachable\n";
+  out << "trip,step,dstar_ms,astar_ms,dijkstra_ms,dstar_expanded,dstar_raised,astar_settled,route_edges_before,reachable,dstar_path_checks\n";
   for (const ReplanSample& r : samples) {
     out << r.trip << ',' << r.step << ',' << r.dstar_ms << ',' << r.astar_ms << ',' << r.dijkstra_ms << ','
         << r.dstar_expanded << ',' << r.dstar_raised << ',' << r.astar_settled << ',' << r.route_edges_before << ','
-        << (r.reachable ? 1 : 0) << '\n';
+        << (r.reachable ? 1 : 0) << ',' << r.dstar_path_checks << '\n';
   }
 }
 
@@ -163,7 +163,7 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
   res.edges = graph.edge_count();
   std::vector<double> t_dstar, t_astar, t_dijkstra, t_dstar0, t_astar0;
   std::vector<double> planner_bytes;
-  double expanded = 0, rekeyed = 0, raised = 0, astar_settled = 0, dijkstra_settled = 0;
+  double expanded = 0, rekeyed = 0, raised = 0, path_checks = 0, astar_settled = 0, dijkstra_settled = 0;
   planner::OneToOneSearch astar, dijkstra;
   std::uniform_int_distribution<std::uint32_t> any_edge(0, static_cast<std::uint32_t>(graph.edge_count() - 1));
   maps::ProgressBar progress("bench replan", config.trips);
@@ -185,7 +185,7 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
       }
     }
     auto t0 = Clock::now();
-    planner::DStarLite dstar(cost, {start}, {goal});
+    planner::DStarLite dstar(cost, {start}, {goal}, planner::DStarLiteOptions{config.lazy_raises});
     dstar.replan();
     planner::Route route = dstar.route();
     t_dstar0.push_back(ms_since(t0));
@@ -215,6 +215,7 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
       expanded += static_cast<double>(stats.expanded);
       rekeyed += static_cast<double>(stats.rekeyed);
       raised += static_cast<double>(stats.underconsistent);
+      path_checks += static_cast<double>(stats.path_checks);
 
       const planner::SearchSpace space(cost, {*position}, {goal});
       planner::SearchStats s_astar, s_dijkstra;
@@ -237,8 +238,8 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
       }
       ++res.replans;
       res.samples.push_back({trip, step, t_dstar.back(), t_astar.back(), config.run_dijkstra ? t_dijkstra.back() : 0.0,
-                             stats.expanded, stats.underconsistent, s_astar.settled, route.edges.size(),
-                             next.found});
+                             stats.expanded, stats.underconsistent, s_astar.settled, stats.path_checks,
+                             route.edges.size(), next.found});
       // Unchanged means: the new route is the rest of the old one from the vehicle's edge on.
       const auto from = std::find(route.edges.begin(), route.edges.end(), next.edges.empty() ? kInvalidEdge : next.edges.front());
       if (!std::equal(from, route.edges.end(), next.edges.begin(), next.edges.end())) ++res.route_changes;
@@ -262,6 +263,7 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
   res.dstar_max_bytes_per_planner = planner_bytes.empty() ? 0.0 : *std::max_element(planner_bytes.begin(), planner_bytes.end());
   res.dstar_mean_rekeyed = rekeyed / n;
   res.dstar_mean_raised = raised / n;
+  res.dstar_mean_path_checks = path_checks / n;
   res.astar_mean_settled = astar_settled / n;
   res.dijkstra_mean_settled = dijkstra_settled / n;
   return res;
@@ -303,12 +305,14 @@ nlohmann::json to_json(const ReplanBenchResult& r, const ReplanBenchConfig& c) {
     astar_ok.push_back(x.astar_ms);
   }
   j["dstar"]["goal_reachable"] = to_json(summarize_ms(dstar_ok));
-  j["astar"]["goal_reachable"] = to_json(summarize_ms(astar_ok));
   j["replans_goal_cut_off"] = cut_off;
   j["heuristic"] = "ALT, " + std::to_string(r.landmarks) + " landmarks (free-flow time)";
   j["dstar"]["mean_rekeyed"] = r.dstar_mean_rekeyed;
   j["dstar"]["mean_raised"] = r.dstar_mean_raised;
+  j["dstar"]["lazy_raises"] = c.lazy_raises;
+  j["dstar"]["mean_path_checks"] = r.dstar_mean_path_checks;
   j["astar"] = to_json(r.astar);
+  j["astar"]["goal_reachable"] = to_json(summarize_ms(astar_ok));
   j["astar"]["mean_settled"] = r.astar_mean_settled;
   if (c.run_dijkstra) {
     j["dijkstra"] = to_json(r.dijkstra);

@@ -27,6 +27,7 @@ struct ReplanBenchConfig {
   double clearing_fraction = 0.35;
   double min_trip_m = 0.0;         // straight-line; 0 = a third of the map's diagonal, at most 5 km
   bool run_dijkstra = true;
+  bool lazy_raises = false;        // D* Lite's lazy raises (DStarLiteOptions); default: the eager paper version
   std::uint32_t max_replans_per_trip = 1000;
 };
 
@@ -52,6 +53,7 @@ struct ReplanSample {
   std::uint64_t dstar_expanded = 0;
   std::uint64_t dstar_raised = 0;
   std::uint64_t astar_settled = 0;
+  std::uint64_t dstar_path_checks = 0;
   std::size_t route_edges_before = 0;
   bool reachable = true;
 };
@@ -72,12 +74,14 @@ struct ReplanBenchResult {
   double dstar_max_bytes_per_planner = 0;
   double dstar_mean_rekeyed = 0;
   double dstar_mean_raised = 0;
+  double dstar_mean_path_checks = 0;  // lazy raises: path walks per replan
   double astar_mean_settled = 0;
   double dijkstra_mean_settled = 0;
   std::vector<ReplanSample> samples;
 };
 
-// trip,step,dstar_ms,astar_ms,dijkstra_ms,dstar_expanded,dstar_raised,astar_settled,route_edges_before,reachable
+// trip,step,dstar_ms,astar_ms,dijkstra_ms,dstar_expanded,dstar_raised,astar_settled,route_edges_before,reachable,
+// dstar_path_checks
 void write_samples_csv(std::ostream& out, const std::vector<ReplanSample>& samples);
 
 // Throws std::invalid_argument for a config that cannot run (no trips, negative fractions, ...).

@@ -5,8 +5,10 @@
 
 namespace corridor::planner {
 
-DStarLite::DStarLite(const TravelCost& cost, std::vector<EdgePoint> starts, std::vector<EdgePoint> goals)
+DStarLite::DStarLite(const TravelCost& cost, std::vector<EdgePoint> starts, std::vector<EdgePoint> goals,
+                     DStarLiteOptions options)
     : space_(cost, std::move(starts), std::move(goals)),
+      options_(options),
       states_(std::make_unique<PagedVertexStates>(space_.vertex_count())),
       open_(PagedVertexStates::HeapPositions(states_.get())) {
   // Initialize(): the search runs backward, so it starts at the goal. (Koenig & Likhachev Fig. 4)
@@ -27,11 +29,14 @@ double DStarLite::min_successor_cost(Vertex u) const {
   return best;
 }
 
-void DStarLite::update_vertex(Vertex u) {
-  if (g(u) != rhs(u)) {
-    open_.push_or_update(u.v, calculate_key(u));
-  } else {
+void DStarLite::update_vertex(Vertex u, bool activate) {
+  const double gu = g(u);
+  const double ru = rhs(u);
+  if (gu == ru) {
     open_.remove(u.v);
+  } else if (ru < gu || !options_.lazy_raises || activate || u == space_.start() || open_.contains(u.v)) {
+    // S is always queued when stale: the loop's own condition waits on it.
+    open_.push_or_update(u.v, calculate_key(u));
   }
 }
 
@@ -70,6 +75,28 @@ void DStarLite::nodes_changed(std::span<const NodeId> nodes) {
 
 ReplanStats DStarLite::replan() {
   ReplanStats stats;
+  // A start whose every arc is closed reaches nothing, and a goal whose every arc is closed is
+  // reached from nowhere, whatever the g values. The loop would settle the whole old search tree to
+  // prove it (S's key is infinite); stop at once instead. The queue keeps its entries, so the next
+  // replan carries on from a state that is still D* Lite's.
+  const Vertex start = space_.start();
+  bool start_cut_off = true;
+  space_.for_each_successor(start, [&](Vertex, double c, EdgeId) { start_cut_off = start_cut_off && c >= kInfCost; });
+  bool goal_cut_off = true;
+  space_.for_each_predecessor(space_.goal(), [&](Vertex, double c) { goal_cut_off = goal_cut_off && c >= kInfCost; });
+  cut_off_ = start_cut_off || goal_cut_off;
+  if (cut_off_) return stats;
+  // Lazy raises (Delayed D*): settle what the start's key requires, then check the path the g values
+  // give. A stale vertex on it is queued and the search goes on; a path consistent from end to end
+  // costs exactly what rhs(S) says, and every vertex off it has a g that is a lower bound or a key
+  // at or above S's, so no other path can be cheaper (docs/routing.md).
+  do {
+    compute_shortest_path(stats);
+  } while (options_.lazy_raises && activate_stale_on_path(stats));
+  return stats;
+}
+
+void DStarLite::compute_shortest_path(ReplanStats& stats) {
   const Vertex start = space_.start();
   const Vertex goal = space_.goal();
   // The paper stops once TopKey >= key(start). Here S's arcs can cost 0 (the vehicle exactly at a
@@ -81,16 +108,6 @@ ReplanStats DStarLite::replan() {
     const double slack = 1e-9 * std::max(1.0, std::abs(ks.k1));
     return open_.top_key().k1 <= ks.k1 + slack || rhs(start) > g(start);
   };
-  // A start whose every arc is closed reaches nothing, and a goal whose every arc is closed is
-  // reached from nowhere, whatever the g values. The loop would settle the whole old search tree to
-  // prove it (S's key is infinite); stop at once instead. The queue keeps its entries, so the next
-  // replan carries on from a state that is still D* Lite's.
-  bool start_cut_off = true;
-  space_.for_each_successor(start, [&](Vertex, double c, EdgeId) { start_cut_off = start_cut_off && c >= kInfCost; });
-  bool goal_cut_off = true;
-  space_.for_each_predecessor(goal, [&](Vertex, double c) { goal_cut_off = goal_cut_off && c >= kInfCost; });
-  cut_off_ = start_cut_off || goal_cut_off;
-  if (cut_off_) return stats;
   while (!open_.empty() && must_continue()) {
     const Vertex u{open_.top()};
     const Key k_old = open_.top_key();
@@ -125,14 +142,54 @@ ReplanStats DStarLite::replan() {
         if (s != goal && rhs(s) == add_cost(c, g_old)) {
           states_->at(s.v).rhs = min_successor_cost(s);
           ++stats.updated;
-          update_vertex(s);
+          // A raise, once started, runs through everything it supported, lazy or not. Left waiting,
+          // the vertices u supported would re-derive their values from each other's stale ones and
+          // climb by one arc's cost per round (counting to infinity around a closed-off area).
+          update_vertex(s, true);
         }
       });
       // rhs(u) depends only on u's successors, which did not change: it stays valid.
       update_vertex(u);
     }
   }
-  return stats;
+}
+
+bool DStarLite::activate_stale_on_path(ReplanStats& stats) {
+  ++stats.path_checks;
+  const Vertex start = space_.start();
+  const Vertex goal = space_.goal();
+  if (rhs(start) > g(start)) {
+    update_vertex(start, true);
+    ++stats.activated;
+    return true;
+  }
+  if (rhs(start) >= kInfCost) return false;
+  Vertex u = start;
+  // Along consistent vertices g falls strictly (every arc but S's costs more than 0), so the walk
+  // reaches G or a stale vertex within vertex_count steps.
+  for (std::size_t steps = 0; u != goal && steps < space_.vertex_count(); ++steps) {
+    double best = kInfCost;
+    Vertex next;
+    space_.for_each_successor(u, [&](Vertex v, double c, EdgeId) {
+      const double total = add_cost(c, v == goal ? 0.0 : g(v));
+      if (total < best) {
+        best = total;
+        next = v;
+      }
+    });
+    if (!next.valid() || next == goal) return false;
+    const VertexState& sn = states_->get(next.v);
+    if (sn.g < sn.rhs) {
+      update_vertex(next, true);
+      ++stats.activated;
+      return true;
+    }
+    // An overconsistent vertex on the path has a key at S's (within rounding), as in the paper's
+    // own termination; the path through it is the one the eager search would also return.
+    if (sn.g > sn.rhs) return false;
+    u = next;
+  }
+  return false;
 }
 
 std::string DStarLite::invariant_violation() const {
@@ -143,7 +200,10 @@ std::string DStarLite::invariant_violation() const {
       return "vertex " + std::to_string(i) + ": rhs " + std::to_string(rhs(u)) + " but successors give " +
              std::to_string(expected_rhs);
     }
-    if ((g(u) != rhs(u)) != open_.contains(i)) {
+    const bool queued = open_.contains(i);
+    const bool must_queue = options_.lazy_raises ? rhs(u) < g(u) : g(u) != rhs(u);
+    const bool may_queue = g(u) != rhs(u);
+    if ((must_queue && !queued) || (queued && !may_queue)) {
       return "vertex " + std::to_string(i) + ": queued=" + std::to_string(open_.contains(i)) + " g=" +
              std::to_string(g(u)) + " rhs=" + std::to_string(rhs(u));
     }

@@ -1,5 +1,8 @@
 // D* Lite (Koenig & Likhachev 2002, optimized version with key modifier km): one vehicle's route,
 // searched backward from the goal and repaired incrementally as costs change and the vehicle moves.
+// Optionally, raises (cost increases) are repaired lazily, as in Delayed D* (Ferguson & Stentz
+// 2005): only where they reach the vehicle's current path. Measured slower at metro scale (see
+// docs/routing.md), so off by default.
 #pragma once
 
 #include <cstdint>
@@ -21,13 +24,26 @@ struct ReplanStats {
   std::uint64_t rekeyed = 0;         // of those, put back with a fresher key
   std::uint64_t underconsistent = 0;  // of those, raised to infinity (a cost increase propagating)
   std::uint64_t updated = 0;         // rhs values changed
+  std::uint64_t path_checks = 0;     // lazy raises: walks of the path looking for stale values
+  std::uint64_t activated = 0;       // lazy raises: stale vertices those walks put on the queue
+};
+
+struct DStarLiteOptions {
+  // true: a vertex whose value a cost change raised (underconsistent) waits off the queue until a
+  // path check finds it on the vehicle's path; from there the raise runs as in the paper. Its stale
+  // g is a lower bound, and the final path is checked consistent end to end, so routes stay
+  // optimal; raises that never reach the path are never paid for. false: the paper's eager repair,
+  // which queues every inconsistent vertex at once. On Porto the stale values that lazy raises leave
+  // behind spread through later decreases and must be raised after all: 1.6x the raises, p99 2x.
+  bool lazy_raises = false;
 };
 
 class DStarLite {
  public:
   // `cost` must outlive the planner. The caller changes the CostOverlay behind it and then reports
   // the changed ids through edges_changed / nodes_changed before the next replan().
-  DStarLite(const TravelCost& cost, std::vector<EdgePoint> starts, std::vector<EdgePoint> goals);
+  DStarLite(const TravelCost& cost, std::vector<EdgePoint> starts, std::vector<EdgePoint> goals,
+            DStarLiteOptions options = {});
 
   // The vehicle has moved. Cheap: the repair happens in replan().
   void move_start(std::vector<EdgePoint> starts);
@@ -49,7 +65,8 @@ class DStarLite {
   [[nodiscard]] std::size_t memory_bytes() const;
 
   // Checks D* Lite's invariants over every vertex: rhs(u) = min over successors of c + g, and a
-  // vertex is queued exactly when it is inconsistent. O(V + E); for tests. Empty when all hold.
+  // vertex is queued exactly when it is inconsistent (lazy raises: every overconsistent vertex is
+  // queued, and every queued one is inconsistent). O(V + E); for tests. Empty when all hold.
   [[nodiscard]] std::string invariant_violation() const;
 
  private:
@@ -61,13 +78,21 @@ class DStarLite {
 
   [[nodiscard]] Key calculate_key(Vertex s) const;
   [[nodiscard]] double min_successor_cost(Vertex u) const;
-  void update_vertex(Vertex u);
+  // Queues u if inconsistent, else takes it off. Lazy raises: an underconsistent u is queued only
+  // if it already was, or `activate` is set.
+  void update_vertex(Vertex u, bool activate = false);
   void recompute_rhs(Vertex u);
+  // ComputeShortestPath's loop, until the start's key is reached.
+  void compute_shortest_path(ReplanStats& stats);
+  // Walks the greedy path from the start and queues the first vertex on it whose value
+  // is stale (underconsistent). False when the whole path is consistent: it is then optimal.
+  bool activate_stale_on_path(ReplanStats& stats);
 
   [[nodiscard]] double g(Vertex v) const { return states_->get(v.v).g; }
   [[nodiscard]] double rhs(Vertex v) const { return states_->get(v.v).rhs; }
 
   SearchSpace space_;
+  DStarLiteOptions options_;
   std::unique_ptr<PagedVertexStates> states_;  // on the heap: the open list points into it
   IndexedHeap<Key, PagedVertexStates::HeapPositions> open_;
   double km_ = 0.0;

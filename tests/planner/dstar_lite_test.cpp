@@ -64,7 +64,9 @@ TEST(DStarLite, InitialPlanMatchesDijkstraOnRandomGraphs) {
 
 // Thousands of random update sequences: cost increases and decreases on and off the route,
 // closures and reopenings, node delay changes, and start moves, checked after every replan.
-TEST(DStarLite, ReplanMatchesDijkstraAfterRandomUpdateSequences) {
+class DStarLiteRepair : public ::testing::TestWithParam<bool> {};
+
+TEST_P(DStarLiteRepair, ReplanMatchesDijkstraAfterRandomUpdateSequences) {
   int replans = 0;
   constexpr std::uint64_t kSequences = 200;
   for (std::uint64_t seed = 1; seed <= kSequences; ++seed) {
@@ -76,7 +78,7 @@ TEST(DStarLite, ReplanMatchesDijkstraAfterRandomUpdateSequences) {
     std::uniform_real_distribution<double> unit(0.0, 1.0);
     auto starts = with_twin(g, random_point(g, rng));
     const auto goals = std::vector<EdgePoint>{random_point(g, rng)};
-    DStarLite dstar(cost, starts, goals);
+    DStarLite dstar(cost, starts, goals, DStarLiteOptions{GetParam()});
     dstar.replan();
     for (int step = 0; step < 25; ++step) {
       const Route current = dstar.route();
@@ -127,6 +129,9 @@ TEST(DStarLite, ReplanMatchesDijkstraAfterRandomUpdateSequences) {
   }
   EXPECT_EQ(replans, kSequences * 25);
 }
+
+INSTANTIATE_TEST_SUITE_P(EagerAndLazyRaises, DStarLiteRepair, ::testing::Bool(),
+                         [](const ::testing::TestParamInfo<bool>& p) { return p.param ? "lazy" : "eager"; });
 
 // A mission that touches a small part of a big graph holds a small part of its state: the per-vertex
 // records live in pages allocated on first write.
