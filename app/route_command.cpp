@@ -11,10 +11,12 @@
 #include "app/map_options.hpp"
 #include "maps/edge_snapper.hpp"
 #include "maps/errors.hpp"
+#include "maps/intersection_geometry.hpp"
 #include "planner/dstar_lite.hpp"
 #include "planner/one_to_one_search.hpp"
 #include "planner/route_geojson.hpp"
 #include "planner/snap_points.hpp"
+#include "preemption/signal_costs.hpp"
 
 namespace corridor::app {
 namespace {
@@ -26,6 +28,7 @@ struct RouteOptions {
   std::optional<double> vmax_kmh;  // the profile's when not given
   std::string algo = "dstar";
   double signal_delay_s = 0.0;
+  std::string signals = "flat";
   double max_snap_m = 200.0;
   std::string profile = "ambulance";
 };
@@ -62,6 +65,9 @@ void run_route(const RouteOptions& o) {
   }
   if (o.vmax_kmh && !(*o.vmax_kmh > 0.0 && *o.vmax_kmh <= 400.0)) throw UsageError("--vmax-kmh must be in (0, 400]");
   if (!(o.signal_delay_s >= 0.0 && o.signal_delay_s < 3600.0)) throw UsageError("--signal-delay-s must be in [0, 3600)");
+  if (o.signals != "flat" && o.signals != "preempted" && o.signals != "normal") {
+    throw UsageError("--signals must be flat, preempted or normal, got '" + o.signals + "'");
+  }
   const maps::LatLon from = parse_lat_lon(o.from, "--from");
   const maps::LatLon to = parse_lat_lon(o.to, "--to");
 
@@ -80,6 +86,13 @@ void run_route(const RouteOptions& o) {
 
   planner::CostOverlay overlay(graph);
   overlay.set_signal_delay(graph, o.signal_delay_s);
+  if (o.signals != "flat") {
+    // Each movement through a signal waits by its green share in the intersection's normal program
+    // (the default NEMA plan from its legs), as the server charges it.
+    preemption::set_signal_costs(overlay, graph, maps::default_signal_plans(graph),
+                                 o.signals == "preempted" ? preemption::SignalCostRule::preempted
+                                                          : preemption::SignalCostRule::normal);
+  }
   planner::VehicleProfile profile = planner::profile_by_name_or_file(o.profile);
   if (o.vmax_kmh) profile.vmax_mps = *o.vmax_kmh / 3.6;
   const planner::TravelCost cost(graph, overlay, profile);
@@ -98,6 +111,7 @@ void run_route(const RouteOptions& o) {
   auto feature = planner::route_to_geojson(graph, route, planner::to_string(algo));
   feature["properties"]["snap_distance_m"] = {s.distance_m, t.distance_m};
   feature["properties"]["profile"] = profile.name;
+  feature["properties"]["signal_costs"] = o.signals;
   std::cout << feature.dump() << '\n';
 }
 
@@ -114,6 +128,10 @@ void register_route_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--algo", options->algo, "dstar, astar or dijkstra")->capture_default_str();
   cmd->add_option("--signal-delay-s", options->signal_delay_s, "expected delay at each signalized intersection")
+      ->capture_default_str();
+  cmd->add_option("--signals", options->signals,
+                  "signal costs: flat (--signal-delay-s per intersection), preempted (each movement's expected "
+                  "transition to its green) or normal (each movement's expected red in the normal program)")
       ->capture_default_str();
   cmd->add_option("--max-snap-m", options->max_snap_m, "farthest a coordinate may be from a road")->capture_default_str();
   cmd->callback([options] { run_route(*options); });

@@ -1,8 +1,10 @@
 // Live traffic conditions over an immutable RoadGraph: per-edge congestion factor and queue delay,
-// closures, and per-node crossing delay (for example the expected signal delay). Shared by all
-// planners of a server; planners are told which ids changed.
+// closures, per-node crossing delay, and per-movement delay (the expected signal wait of one turn,
+// from the green share of its movement). Shared by all planners of a server; planners are told
+// which ids changed (a movement's delay changes through its node).
 #pragma once
 
+#include <cstdint>
 #include <stdexcept>
 #include <vector>
 
@@ -35,12 +37,31 @@ class CostOverlay {
 
   [[nodiscard]] const EdgeCondition& edge(EdgeId e) const { return edges_[e.index()]; }
   [[nodiscard]] double node_delay_s(NodeId v) const { return node_delay_s_[v.index()]; }
+
+  // The delay of the movement from `in` onto `out` at the node where they meet, on top of that
+  // node's delay. Throws CostUpdateError for an unknown id, edges that do not meet (head(in) !=
+  // tail(out)), or a value that is negative or not finite.
+  void set_turn_delay(EdgeId in, EdgeId out, double delay_s);
+  // 0 where none was set. Cheap: one load where the node has none, three where it has.
+  [[nodiscard]] double turn_delay_s(EdgeId in, EdgeId out) const {
+    if (turn_row_.empty()) return 0.0;
+    const std::uint32_t row = turn_row_[in.index()];
+    if (row == 0) return 0.0;
+    return turn_delay_s_[row - 1 + (out.v - first_out_at_head_[in.index()])];
+  }
+  [[nodiscard]] bool has_turn_delays() const { return !turn_row_.empty(); }
   [[nodiscard]] std::size_t edge_count() const { return edges_.size(); }
   [[nodiscard]] std::size_t node_count() const { return node_delay_s_.size(); }
 
  private:
+  const maps::RoadGraph* graph_;
   std::vector<EdgeCondition> edges_;
   std::vector<double> node_delay_s_;
+  // Per in-edge: 1 + where its row of delays (one per out-edge of its head, in CSR order) starts in
+  // turn_delay_s_, or 0 for none; and the first out-edge id at its head. Allocated on first use.
+  std::vector<std::uint32_t> turn_row_;
+  std::vector<std::uint32_t> first_out_at_head_;
+  std::vector<double> turn_delay_s_;
 };
 
 }  // namespace corridor::planner

@@ -98,13 +98,13 @@ class SearchSpace {
       return;
     }
     if (u == goal()) return;
-    const NodeId n = node(u);
-    const bool at_goal_tail = std::binary_search(goal_tails_.begin(), goal_tails_.end(), n);
+    const EdgeId in = edge(u);
+    const bool at_goal_tail = std::binary_search(goal_tails_.begin(), goal_tails_.end(), cost_->graph().head(in));
     for (const maps::TurnArc& a : turns_->arcs_out(u.v)) {
-      const double turn = cost_->turn_s(a);
-      if (turn >= kInfCost) continue;
       const Vertex v{a.other};
       const EdgeId onto = edge(v);
+      const double turn = cost_->turn_cost_s(in, a, onto);
+      if (turn >= kInfCost) continue;
       f(v, add_cost(turn, cost_->transit_s(onto)), onto);
       if (!at_goal_tail) continue;
       for (const EdgePoint& t : goals_) {
@@ -123,7 +123,7 @@ class SearchSpace {
         const double arc = goal_arc_s(t);
         auto from_turns_into = [&](std::uint32_t x) {
           for (const maps::TurnArc& a : turns_->arcs_in(x)) {
-            const double turn = cost_->turn_s(a);
+            const double turn = cost_->turn_cost_s(edge(Vertex{a.other}), a, t.edge);
             if (turn < kInfCost) f(Vertex{a.other}, add_cost(turn, arc));
           }
         };
@@ -140,7 +140,7 @@ class SearchSpace {
     const EdgeId e = edge(v);
     const double drive = cost_->transit_s(e);
     for (const maps::TurnArc& a : turns_->arcs_in(v.v)) {
-      const double turn = cost_->turn_s(a);
+      const double turn = cost_->turn_cost_s(edge(Vertex{a.other}), a, e);
       if (turn < kInfCost) f(Vertex{a.other}, add_cost(turn, drive));
     }
     for (const EdgePoint& s : starts_) {

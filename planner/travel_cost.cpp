@@ -39,9 +39,10 @@ TravelCost::TravelCost(const maps::RoadGraph& graph, const CostOverlay& overlay,
 std::pair<double, std::uint32_t> TravelCost::turn_onto(std::uint32_t from, EdgeId next) const {
   const auto& t = graph_->turns();
   std::pair<double, std::uint32_t> best{kInfCost, next.v};
+  const EdgeId in = t.edge_of(from);
   for (const maps::TurnArc& a : t.arcs_out(from)) {
     if (t.edge_of(a.other) == next) {
-      const double c = turn_s(a);
+      const double c = turn_cost_s(in, a, next);
       if (c < best.first || best.first >= kInfCost) best = {c, a.other};
     }
   }

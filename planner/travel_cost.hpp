@@ -68,8 +68,16 @@ class TravelCost {
     return angle_cost_s_[static_cast<std::size_t>(a.angle_deg + 180)];
   }
 
-  // The turn from turn-graph vertex `from` onto edge `next`: its turn_s (kInfCost when the graph has
-  // no such turn) and the vertex it leads to (a copy of next, where a via-way restriction needs it).
+  // The whole cost of turning by arc `a` from edge `in` onto edge `out`: turn_s plus the movement's
+  // delay on the overlay (its expected signal wait). Every search, the route's ETAs and the trip
+  // simulator charge a turn through this (or turn_onto), so they agree to the last bit.
+  [[nodiscard]] double turn_cost_s(EdgeId in, const maps::TurnArc& a, EdgeId out) const {
+    const double t = turn_s(a);
+    return t >= kInfCost ? t : t + overlay_->turn_delay_s(in, out);
+  }
+
+  // The turn from turn-graph vertex `from` onto edge `next`: its turn_cost_s (kInfCost when the graph
+  // has no such turn) and the vertex it leads to (a copy of next, where a via-way restriction needs it).
   [[nodiscard]] std::pair<double, std::uint32_t> turn_onto(std::uint32_t from, EdgeId next) const;
 
   // Driving from offset `from_m` to `to_m` on e. The queue delay is spread along the edge in

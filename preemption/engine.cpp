@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "maps/intersection_geometry.hpp"
+#include "preemption/plan_movement.hpp"
 
 namespace corridor::preemption {
 namespace {
@@ -106,19 +107,7 @@ std::optional<PreemptionEngine::VicinityStart> PreemptionEngine::vicinity_start(
 bool PreemptionEngine::time_entry(ScheduleEntry& e, const Crossing& c, const Crossing* previous, double now_s) {
   const maps::SignalPlan& plan = plans_.at(c.node);
   const maps::Compass from = maps::approach_side(graph_, c.in_edge);
-  std::optional<std::size_t> movement;
-  if (!plan.movement_edge.empty()) {
-    const auto it = std::find(plan.movement_edge.begin(), plan.movement_edge.end(), c.out_edge);
-    if (it != plan.movement_edge.end()) movement = static_cast<std::size_t>(it - plan.movement_edge.begin());
-  }
-  if (!movement) movement = plan.movement_index(from, maps::exit_side(graph_, c.out_edge));
-  if (!movement) {
-    // Leaving by the side it came from (a U-turn) or by a leg the plan merged: the approach's
-    // through movement stands for it; every phase choice below depends on the approach.
-    for (std::size_t m = 0; m < plan.movements.size() && !movement; ++m) {
-      if (plan.movements[m].from == from) movement = m;
-    }
-  }
+  const std::optional<std::size_t> movement = plan_movement(graph_, plan, c.in_edge, c.out_edge);
   if (!movement) return false;
   e.node = c.node;
   e.movement = *movement;

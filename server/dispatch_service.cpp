@@ -79,10 +79,11 @@ DispatchService::DispatchService(const maps::RoadGraph& graph, std::unordered_ma
   if (config_.repair_threads < 1 || config_.repair_threads > 64) {
     throw std::invalid_argument("repair_threads must be 1 to 64, not " + std::to_string(config_.repair_threads));
   }
-  // Every mission's lights are preempted, so a light with a plan costs its expected transition
-  // (the rule the SUMO loop uses too); a signal without a plan keeps the flat expected delay.
+  // Every mission's lights are preempted, so each movement through a light with a plan costs its
+  // expected transition (the rule the SUMO loop uses too); a signal without a plan keeps the flat
+  // expected delay.
   overlay_.set_signal_delay(graph, config_.signal_delay_s);
-  preemption::set_signal_costs(overlay_, plans_, preemption::SignalCostRule::preempted);
+  preemption::set_signal_costs(overlay_, graph, plans_, preemption::SignalCostRule::preempted);
   for (EdgeId e : graph.edges()) edges_by_way_.emplace(graph.osm_way(e).v, e);
   if (config_.repair_threads > 1) {
     repair_pool_ = std::make_unique<boost::asio::thread_pool>(static_cast<std::size_t>(config_.repair_threads - 1));

@@ -297,7 +297,7 @@ std::vector<EvTrip> conflicting_ev_trips(const SumoScenario& scenario, const EvT
   const auto& g = sg.graph;
   // The loop's own initial costs, so that the predicted meeting is the one the planners will see.
   planner::CostOverlay overlay(g);
-  preemption::set_signal_costs(overlay, scenario.plans, preemption::SignalCostRule::preempted);
+  preemption::set_signal_costs(overlay, g, scenario.plans, preemption::SignalCostRule::preempted);
   const planner::TravelCost cost(g, overlay, {ev_vmax_kmh / 3.6});
   planner::OneToOneSearch search;
   const auto starts = detail::points_on(sg, first.from, 0.0);

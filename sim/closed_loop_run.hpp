@@ -163,7 +163,7 @@ ClosedLoopResult run_loop(const SumoScenario& scenario, const ClosedLoopConfig& 
 
   planner::CostOverlay overlay(g);
   // The route knows its own preemption: the server's rule (preemption/signal_costs.hpp).
-  preemption::set_signal_costs(overlay, scenario.plans,
+  preemption::set_signal_costs(overlay, g, scenario.plans,
                                preempts(config.signals) ? preemption::SignalCostRule::preempted : preemption::SignalCostRule::normal);
   const planner::TravelCost cost(g, overlay, {vmax_mps});
 

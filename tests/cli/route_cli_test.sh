@@ -149,6 +149,28 @@ PY
 then pass; else fail "preemption tables --json"; fi
 "$corridor" preemption tables | grep -q "agree in 12 of 96 cells" && pass || fail "preemption tables text"
 
+# 6b. Signal costs per movement: a route that crosses signals costs more with their waits than
+# without, the rule is echoed, and an unknown rule is a usage error.
+from_sig=43.7384,7.4246
+to_sig=43.7450,7.4300
+if "$corridor" route --from "$from_sig" --to "$to_sig" > "$work/flat.json" 2> /dev/null &&
+   "$corridor" route --from "$from_sig" --to "$to_sig" --signals preempted > "$work/pre.json" 2> /dev/null &&
+   "$corridor" route --from "$from_sig" --to "$to_sig" --signals normal > "$work/nor.json" 2> /dev/null &&
+   python3 - "$work/flat.json" "$work/pre.json" "$work/nor.json" <<'PY'
+import json, sys
+flat, pre, nor = (json.load(open(f))["properties"] for f in sys.argv[1:])
+assert (flat["signal_costs"], pre["signal_costs"], nor["signal_costs"]) == ("flat", "preempted", "normal")
+assert len(flat["signals"]) > 0, "the test route should cross a signal"
+# Waits only add; the normal program's reds cost more than a preempted transition.
+assert flat["travel_time_s"] < pre["travel_time_s"] <= nor["travel_time_s"], (flat["travel_time_s"], pre["travel_time_s"], nor["travel_time_s"])
+PY
+then pass; else fail "route --signals"; fi
+set +e
+"$corridor" route --from "$from_sig" --to "$to_sig" --signals sometimes > /dev/null 2> "$work/err"
+code=$?
+set -e
+if [[ $code == 2 ]] && grep -q "flat, preempted or normal" "$work/err"; then pass; else fail "route --signals sometimes: exit $code, $(cat "$work/err")"; fi
+
 # 7. The server load benchmark: a short paced run on the embedded map keeps its keys, answers every
 # request, and reads back one per-mission repair sample for each congestion-triggered replan.
 "$corridor" bench serve --seconds 1.5 --rate 400 --vehicles 20 --missions 10 --congestion-edges-per-s 400 > "$work/serve.json" 2> /dev/null

@@ -63,7 +63,8 @@ TEST(DStarLite, InitialPlanMatchesDijkstraOnRandomGraphs) {
 }
 
 // Thousands of random update sequences: cost increases and decreases on and off the route,
-// closures and reopenings, node delay changes, and start moves, checked after every replan.
+// closures and reopenings, node and movement delay changes, and start moves, checked after every
+// replan.
 class DStarLiteRepair : public ::testing::TestWithParam<bool> {};
 
 TEST_P(DStarLiteRepair, ReplanMatchesDijkstraAfterRandomUpdateSequences) {
@@ -104,6 +105,15 @@ TEST_P(DStarLiteRepair, ReplanMatchesDijkstraAfterRandomUpdateSequences) {
         if (unit(rng) < 0.3) {
           const NodeId n{std::uniform_int_distribution<std::uint32_t>(0, static_cast<std::uint32_t>(g.node_count() - 1))(rng)};
           overlay.set_node_delay(n, unit(rng) < 0.5 ? 0.0 : unit(rng) * 40.0);
+          // And a movement's own delay (a signal's green share): reported through its node.
+          const auto ins = g.in_edges(n);
+          const auto outs = g.out_edges(n);
+          if (!ins.empty() && !outs.empty()) {
+            const EdgeId in = ins[std::uniform_int_distribution<std::size_t>(0, ins.size() - 1)(rng)];
+            const EdgeId out{(*outs.begin()).v + std::uniform_int_distribution<std::uint32_t>(
+                                                      0, static_cast<std::uint32_t>(outs.size() - 1))(rng)};
+            overlay.set_turn_delay(in, out, unit(rng) < 0.3 ? 0.0 : unit(rng) * 60.0);
+          }
           nodes.push_back(n);
         }
       }

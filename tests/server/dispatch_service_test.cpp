@@ -71,7 +71,7 @@ TEST(DispatchService, CreatesAMissionWithRouteEtaAndPreemptionSchedule) {
   planner::CostOverlay overlay(grid());
   overlay.set_signal_delay(grid(), DispatchConfig{}.signal_delay_s);
   // Lights with a plan cost their expected transition: the service preempts them.
-  preemption::set_signal_costs(overlay, maps::default_signal_plans(grid()), preemption::SignalCostRule::preempted);
+  preemption::set_signal_costs(overlay, grid(), maps::default_signal_plans(grid()), preemption::SignalCostRule::preempted);
   const planner::TravelCost cost(grid(), overlay, {120.0 / 3.6});
   planner::OneToOneSearch dijkstra;
   const auto oracle = dijkstra.run(planner::SearchSpace(cost, {m.route.start}, {m.route.goal}), false);
@@ -248,7 +248,7 @@ TEST(DispatchService, ConcurrentReportsKeepEveryPlanOptimal) {
   planner::CostOverlay overlay(grid());
   overlay.set_signal_delay(grid(), DispatchConfig{}.signal_delay_s);
   // Lights with a plan cost their expected transition: the service preempts them.
-  preemption::set_signal_costs(overlay, maps::default_signal_plans(grid()), preemption::SignalCostRule::preempted);
+  preemption::set_signal_costs(overlay, grid(), maps::default_signal_plans(grid()), preemption::SignalCostRule::preempted);
   for (const auto& [e, f] : final_factor) overlay.set_edge(e, {f, 0.0});
   const planner::TravelCost cost(grid(), overlay, {120.0 / 3.6});
   planner::OneToOneSearch dijkstra;
@@ -378,7 +378,7 @@ TEST(DispatchService, PersistsAndResumesActiveMissionsAfterRestart) {
   planner::CostOverlay overlay(grid());
   overlay.set_signal_delay(grid(), DispatchConfig{}.signal_delay_s);
   // Lights with a plan cost their expected transition: the service preempts them.
-  preemption::set_signal_costs(overlay, maps::default_signal_plans(grid()), preemption::SignalCostRule::preempted);
+  preemption::set_signal_costs(overlay, grid(), maps::default_signal_plans(grid()), preemption::SignalCostRule::preempted);
   overlay.set_edge(congested[0], {7.0, 0.0});
   const planner::TravelCost cost(grid(), overlay, {120.0 / 3.6});
   planner::OneToOneSearch dijkstra;
@@ -457,7 +457,7 @@ TEST(DispatchService, MissionKeepsItsVehicleProfileAcrossARestart) {
     // The route is the fire engine's: Dijkstra with that profile gives the same cost.
     planner::CostOverlay overlay(grid());
     overlay.set_signal_delay(grid(), DispatchConfig{}.signal_delay_s);
-    preemption::set_signal_costs(overlay, maps::default_signal_plans(grid()), preemption::SignalCostRule::preempted);
+    preemption::set_signal_costs(overlay, grid(), maps::default_signal_plans(grid()), preemption::SignalCostRule::preempted);
     planner::VehicleProfile p = planner::fire_engine_profile();
     p.vmax_mps = 80.0 / 3.6;
     const planner::TravelCost cost(grid(), overlay, p);
