@@ -88,8 +88,8 @@ void run_route(const RouteOptions& o) {
   overlay.set_signal_delay(graph, o.signal_delay_s);
   if (o.signals != "flat") {
     // Each movement through a signal waits by its green share in the intersection's normal program
-    // (the default NEMA plan from its legs), as the server charges it.
-    preemption::set_signal_costs(overlay, graph, maps::default_signal_plans(graph),
+    // (a SUMO net's own plans, else the default NEMA plan from its legs), as the server charges it.
+    preemption::set_signal_costs(overlay, graph, maps::signal_plans_for(o.map.map_file, graph),
                                  o.signals == "preempted" ? preemption::SignalCostRule::preempted
                                                           : preemption::SignalCostRule::normal);
   }

@@ -43,6 +43,7 @@ class CostOverlay {
   // tail(out)), or a value that is negative or not finite.
   void set_turn_delay(EdgeId in, EdgeId out, double delay_s);
   // 0 where none was set. Cheap: one load where the node has none, three where it has.
+  // Precondition: head(in) == tail(out), as for every arc of the turn graph (not checked here).
   [[nodiscard]] double turn_delay_s(EdgeId in, EdgeId out) const {
     if (turn_row_.empty()) return 0.0;
     const std::uint32_t row = turn_row_[in.index()];

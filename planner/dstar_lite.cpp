@@ -201,7 +201,8 @@ std::string DStarLite::invariant_violation() const {
              std::to_string(expected_rhs);
     }
     const bool queued = open_.contains(i);
-    const bool must_queue = options_.lazy_raises ? rhs(u) < g(u) : g(u) != rhs(u);
+    // Lazy raises leave stale vertices off the queue, but never a stale S (the loop waits on it).
+    const bool must_queue = options_.lazy_raises ? rhs(u) < g(u) || (u == space_.start() && g(u) != rhs(u)) : g(u) != rhs(u);
     const bool may_queue = g(u) != rhs(u);
     if ((must_queue && !queued) || (queued && !may_queue)) {
       return "vertex " + std::to_string(i) + ": queued=" + std::to_string(open_.contains(i)) + " g=" +

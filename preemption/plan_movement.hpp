@@ -12,9 +12,10 @@
 namespace corridor::preemption {
 
 // The movement whose edge is `out_edge` (plans that name their movements' edges, as SUMO's do);
-// else the one between the compass sides of the approach and the exit; else, for a U-turn or a leg
-// the plan merged, the approach's first movement, which stands for it (every phase choice depends
-// on the approach). nullopt when the plan has no movement from that approach.
+// else the one between the compass sides of the approach and the exit; else, for a U-turn, the
+// approach's left turn (NEMA plans are for right-hand traffic), and for a leg the plan merged the
+// approach's first movement, which stands for it (every phase choice depends on the approach).
+// nullopt when the plan has no movement from that approach.
 std::optional<std::size_t> plan_movement(const maps::RoadGraph& graph, const maps::SignalPlan& plan, EdgeId in_edge,
                                          EdgeId out_edge);
 

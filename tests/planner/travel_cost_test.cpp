@@ -129,8 +129,14 @@ TEST(CostOverlay, TurnDelayBelongsToOneMovement) {
 TEST(CostOverlay, RejectsInvalidTurnDelays) {
   const auto g = testing::random_grid(3, 4, 4);
   CostOverlay overlay(g);
-  const EdgeId in = EdgeId{0};
+  EdgeId in;
+  for (EdgeId e : g.edges()) {
+    if (!in.valid() && !g.out_edges(g.head(e)).empty()) in = e;
+  }
+  ASSERT_TRUE(in.valid());
   const EdgeId out = *g.out_edges(g.head(in)).begin();
+  ASSERT_EQ(g.tail(out), g.head(in));  // so the value checks below fail on the value, not the pair
+  overlay.set_turn_delay(in, out, 0.0);  // and the pair itself is accepted
   EdgeId elsewhere = out;
   for (EdgeId e : g.edges()) {
     if (g.tail(e) != g.head(in)) elsewhere = e;
@@ -141,7 +147,7 @@ TEST(CostOverlay, RejectsInvalidTurnDelays) {
   EXPECT_THROW(overlay.set_turn_delay(in, out, -1.0), CostUpdateError);
   EXPECT_THROW(overlay.set_turn_delay(in, out, std::nan("")), CostUpdateError);
   EXPECT_THROW(overlay.set_turn_delay(in, out, kInfCost), CostUpdateError);
-  EXPECT_FALSE(overlay.has_turn_delays());  // nothing was stored by the rejected calls
+  EXPECT_DOUBLE_EQ(overlay.turn_delay_s(in, out), 0.0);  // nothing was stored by the rejected calls
 }
 
 // A long wait on the one movement a route makes at a junction moves the route off that movement,
@@ -149,6 +155,7 @@ TEST(CostOverlay, RejectsInvalidTurnDelays) {
 TEST(TravelCost, AMovementDelaySteersTheRouteAndIsCharged) {
   maps::GridSpec spec;  // two-way streets throughout, so every block has a way round it
   spec.rows = spec.cols = 6;
+  spec.removal_fraction = spec.oneway_fraction = spec.diagonal_fraction = 0.0;
   const auto g = maps::make_perturbed_grid(spec);
   CostOverlay overlay(g);
   const TravelCost cost(g, overlay, {30.0});
