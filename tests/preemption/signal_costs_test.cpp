@@ -134,15 +134,26 @@ TEST(SignalCosts, ClosedFormsMatchASampledCycleOnRandomPlans) {
   }
 }
 
-TEST(SignalCosts, OverlayGetsEachMovementsValueByTheRule) {
-  maps::GridSpec spec;  // a plain crossing: four two-way legs
+// A 3 × 3 grid of two-way streets, and its one four-legged crossing (node ids follow a Hilbert
+// order, so it is found, not assumed).
+maps::RoadGraph crossing_grid() {
+  maps::GridSpec spec;
   spec.rows = spec.cols = 3;
   spec.removal_fraction = spec.oneway_fraction = spec.diagonal_fraction = 0.0;
-  const maps::RoadGraph graph = maps::make_perturbed_grid(spec);
-  NodeId centre;  // node ids follow a Hilbert order: find the crossing
+  return maps::make_perturbed_grid(spec);
+}
+
+NodeId crossing(const maps::RoadGraph& graph) {
+  NodeId centre;
   for (NodeId v : graph.nodes()) {
     if (graph.in_edges(v).size() == 4) centre = v;
   }
+  return centre;
+}
+
+TEST(SignalCosts, OverlayGetsEachMovementsValueByTheRule) {
+  const maps::RoadGraph graph = crossing_grid();
+  const NodeId centre = crossing(graph);
   ASSERT_TRUE(centre.valid());
   ASSERT_EQ(graph.in_edges(centre).size(), 4u);
   std::unordered_map<NodeId, maps::SignalPlan> plans;
@@ -190,14 +201,8 @@ TEST(SignalCosts, OverlayGetsEachMovementsValueByTheRule) {
 
 // The movement a turn makes: by the plan's movement edges where it names them, else by compass.
 TEST(PlanMovement, ByEdgeWhereNamedElseByCompass) {
-  maps::GridSpec spec;  // a plain crossing: four two-way legs
-  spec.rows = spec.cols = 3;
-  spec.removal_fraction = spec.oneway_fraction = spec.diagonal_fraction = 0.0;
-  const maps::RoadGraph graph = maps::make_perturbed_grid(spec);
-  NodeId centre;  // node ids follow a Hilbert order: find the crossing
-  for (NodeId v : graph.nodes()) {
-    if (graph.in_edges(v).size() == 4) centre = v;
-  }
+  const maps::RoadGraph graph = crossing_grid();
+  const NodeId centre = crossing(graph);
   ASSERT_TRUE(centre.valid());
   maps::SignalPlan plan = maps::make_nema_plan(centre, maps::legs_of(graph, centre));
   for (EdgeId in : graph.in_edges(centre)) {
