@@ -109,7 +109,7 @@ std::vector<SnapResult> EdgeSnapper::candidates_local(Point2 p, double radius_m,
     const double along = piece.start_along_m + t * distance_m(a, b);
     r.offset_m = geometric > 0.0 ? std::clamp(along * length / geometric, 0.0, length) : 0.0;
     r.twin = graph_.twin(r.edge);
-    if (r.twin.valid()) r.twin_offset_m = std::clamp(graph_.length_m(r.twin) - r.offset_m, 0.0, graph_.length_m(r.twin));
+    if (r.twin.valid()) r.twin_offset_m = graph_.twin_offset_m(r.edge, r.offset_m);
     if (same != out.end()) {
       *same = r;
     } else {
@@ -156,7 +156,7 @@ SnapResult EdgeSnapper::snap_local(Point2 p, const SnapOptions& options) const {
   const double length = graph_.length_m(r.edge);
   r.offset_m = geometric > 0.0 ? std::clamp(along * length / geometric, 0.0, length) : 0.0;
   r.twin = graph_.twin(r.edge);
-  if (r.twin.valid()) r.twin_offset_m = std::clamp(graph_.length_m(r.twin) - r.offset_m, 0.0, graph_.length_m(r.twin));
+  if (r.twin.valid()) r.twin_offset_m = graph_.twin_offset_m(r.edge, r.offset_m);
   return r;
 }
 

@@ -102,6 +102,15 @@ class RoadGraph {
   [[nodiscard]] OsmWayId osm_way(EdgeId e) const { return data_.edge_osm_way[e.index()]; }
   [[nodiscard]] RoadClass road_class(EdgeId e) const { return data_.edge_class[e.index()]; }
   [[nodiscard]] EdgeId twin(EdgeId e) const { return data_.edge_twin[e.index()]; }
+  // The place `offset_m` along e, measured along its twin (which must exist): the same share of the
+  // way from the other end, since the two directions of a road may differ in length (a SUMO net's
+  // lanes do). Clamped onto the twin.
+  [[nodiscard]] double twin_offset_m(EdgeId e, double offset_m) const {
+    const double len = length_m(e);
+    const double twin_len = length_m(twin(e));
+    const double share = len > 0.0 ? offset_m / len : 0.0;
+    return std::clamp(twin_len * (1.0 - share), 0.0, twin_len);
+  }
   // The street's OSM name and ref ("" when the way has none).
   [[nodiscard]] std::string_view name(EdgeId e) const { return data_.strings.at(data_.edge_name[e.index()]); }
   [[nodiscard]] std::string_view ref(EdgeId e) const { return data_.strings.at(data_.edge_ref[e.index()]); }

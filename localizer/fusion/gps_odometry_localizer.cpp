@@ -59,8 +59,7 @@ MatchedPoint GpsOdometryLocalizer::along_road_mean(const MatchedPoint& m, double
     if (r.edge == m.edge) {
       u = r.offset_m;
     } else if (r.edge == graph_.twin(m.edge)) {
-      // A stopped vehicle's match may face either way (and the two ways may differ in length).
-      u = graph_.length_m(m.edge) * (1.0 - r.offset_m / std::max(graph_.length_m(r.edge), 1e-9));
+      u = graph_.twin_offset_m(r.edge, r.offset_m);  // a stopped vehicle's match may face either way
     } else if (before.valid() && r.edge == before) {
       u = r.offset_m - before_len;
     } else {

@@ -86,10 +86,7 @@ void OdometryMapMatcher::seed() {
     hyps_.push_back(h);
   };
   add(start_.edge, start_.offset_m, 0.0);
-  if (const EdgeId twin = graph_.twin(start_.edge); twin.valid()) {
-    // (The two directions of a road may differ in length, as in a SUMO net.)
-    add(twin, graph_.length_m(twin) * (1.0 - start_.offset_m / std::max(graph_.length_m(start_.edge), 1e-9)), 0.0);
-  }
+  if (const EdgeId twin = graph_.twin(start_.edge); twin.valid()) add(twin, graph_.twin_offset_m(start_.edge, start_.offset_m), 0.0);
   if (snapper_ != nullptr) {
     const double radius = std::max(config_.start_radius_m, 2.0 * sigma);
     for (const maps::SnapResult& c : snapper_->candidates_local(start_.point, radius, 8)) {

@@ -52,6 +52,26 @@ TEST(EdgeSnapper, NearestPointMatchesBruteForce) {
   }
 }
 
+// The two directions of a road may differ in length (a SUMO net's lanes do): the twin's offset is
+// the same share of the way from the other end, both ends included.
+TEST(RoadGraph, TwinOffsetIsTheSameShareFromTheOtherEnd) {
+  RoadGraphData d = grid().data();
+  EdgeId e;
+  for (std::uint32_t i = 0; i < d.edge_twin.size() && !e.valid(); ++i) {
+    if (d.edge_twin[i].valid()) e = EdgeId{i};
+  }
+  ASSERT_TRUE(e.valid());
+  const EdgeId t = d.edge_twin[e.index()];
+  d.edge_length_m[t.index()] = 1.5 * d.edge_length_m[e.index()];
+  const RoadGraph g(std::move(d));
+  const double len = g.length_m(e);
+  EXPECT_DOUBLE_EQ(g.twin_offset_m(e, 0.0), 1.5 * len);
+  EXPECT_DOUBLE_EQ(g.twin_offset_m(e, len), 0.0);
+  EXPECT_NEAR(g.twin_offset_m(e, len / 4), 1.5 * len * 0.75, 1e-9);
+  EXPECT_NEAR(g.twin_offset_m(t, g.twin_offset_m(e, len / 3)), len / 3, 1e-9);
+  EXPECT_DOUBLE_EQ(g.twin_offset_m(e, 2 * len), 0.0);  // clamped onto the twin
+}
+
 TEST(EdgeSnapper, LatLonOnARoadSnapsOntoIt) {
   const RoadGraph g = grid();
   const EdgeSnapper snapper(g);
