@@ -81,7 +81,7 @@ void run_match(const MatchOptions& o) {
   std::size_t matched_count = 0;
   for (std::size_t i = 0; i < matched.size(); ++i) {
     const auto& m = matched[i];
-    json p{{"time_s", trace[i].time_s}, {"matched", m.matched}};
+    json p{{"time_s", trace[i].time_s}, {"matched", m.matched}, {"outlier", m.outlier}};
     if (m.matched) {
       ++matched_count;
       const maps::LatLon at = graph.projection().to_lat_lon(m.point);

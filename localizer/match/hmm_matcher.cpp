@@ -16,7 +16,8 @@ constexpr double kNoScore = -std::numeric_limits<double>::infinity();
 
 void HmmConfig::validate() const {
   if (!(sigma_base_m > 0.0) || !(default_hdop > 0.0) || !(beta_m > 0.0) || !(min_radius_m > 0.0) ||
-      !(max_radius_m >= min_radius_m) || !(max_speed_mps > 0.0) || !(gap_s > 0.0) || !(heading_sigma_deg > 0.0) ||
+      !(max_radius_m >= min_radius_m) || !(max_speed_mps > 0.0) || !(gap_s > 0.0) || !(backward_tolerance_m >= 0.0) || !(backward_sigmas >= 0.0) ||
+      !(uturn_penalty >= 0.0) || !(outlier_penalty >= 0.0) || !(heading_sigma_deg > 0.0) ||
       max_candidates == 0 || window == 0) {
     throw std::invalid_argument("map matcher configuration needs positive scales, radii, speed, gap and window");
   }
@@ -57,9 +58,10 @@ std::vector<HmmMatcher::Candidate> HmmMatcher::candidates_for(const GpsFix& fix,
   return out;
 }
 
-bool HmmMatcher::link(const Step& prev, Step& next, const GpsFix& fix, planner::BoundedDistances& distances) {
+void HmmMatcher::relax(const Step& prev, const Step& next, const GpsFix& fix, double penalty, std::uint8_t back,
+                       planner::BoundedDistances& distances, Links& links) const {
   const double dt = next.time_s - prev.time_s;
-  if (dt > config_.gap_s || dt < 0.0) return false;
+  if (dt > config_.gap_s || dt < 0.0) return;
   const double straight = maps::distance_m(prev.raw, next.raw);
   // No route can be longer than the fastest vehicle drives meanwhile; a generous detour budget
   // keeps the searches small where fixes are dense.
@@ -74,11 +76,8 @@ bool HmmMatcher::link(const Step& prev, Step& next, const GpsFix& fix, planner::
   // their difference spreads with the GPS noise: the scale grows with σ, never below beta_m.
   const double hdop = usable_hdop(fix, config_.default_hdop);
   const double beta = std::max(config_.beta_m, config_.beta_per_sigma * hdop * config_.sigma_base_m);
+  const double backward = std::max(config_.backward_tolerance_m, config_.backward_sigmas * hdop * config_.sigma_base_m);
 
-  // Best path score and parent per candidate, applied only if some candidate is reachable: a
-  // failed link leaves `next` as candidates_for made it, the start of a new chain.
-  std::vector<double> best(next.candidates.size(), kNoScore);
-  std::vector<std::int32_t> parent(next.candidates.size(), -1);
   for (std::size_t i = 0; i < prev.candidates.size(); ++i) {
     const Candidate& p = prev.candidates[i];
     if (p.score == kNoScore) continue;
@@ -87,7 +86,7 @@ bool HmmMatcher::link(const Step& prev, Step& next, const GpsFix& fix, planner::
     for (std::size_t j = 0; j < next.candidates.size(); ++j) {
       const Candidate& c = next.candidates[j];
       double route;
-      if (c.edge == p.edge && c.offset_m >= p.offset_m - config_.backward_tolerance_m) {
+      if (c.edge == p.edge && c.offset_m >= p.offset_m - backward) {
         route = std::max(0.0, c.offset_m - p.offset_m);
       } else {
         if (!searched) {
@@ -100,20 +99,29 @@ bool HmmMatcher::link(const Step& prev, Step& next, const GpsFix& fix, planner::
       }
       if (route > bound || (dt > 0.0 && route / dt > config_.max_speed_mps)) continue;
       // Newson & Krumm's transition: exponential in |route − straight line|.
-      double transition = -std::abs(route - straight) / beta;
-      if (use_speed) transition -= std::abs(route - *fix.speed_mps * dt) / (2.0 * beta);
-      const double score = p.score + transition;
-      if (score > best[j]) {
-        best[j] = score;
-        parent[j] = static_cast<std::int32_t>(i);
+      // Where the fix has a speed (Doppler, good to a fraction of a m/s), speed × time measures the
+      // distance driven far better than the straight line between two noisy fixes does (its noise
+      // is σ√2 a side, and all of it at a stop), so the speed term gets the tighter scale.
+      double transition = use_speed ? -std::abs(route - straight) / (2.0 * beta) - std::abs(route - *fix.speed_mps * dt) / beta
+                                     : -std::abs(route - straight) / beta;
+      if (c.edge == graph_.twin(p.edge) && c.edge != p.edge) transition -= config_.uturn_penalty;
+      const double score = p.score + transition - penalty;
+      if (score > links.best[j]) {
+        links.best[j] = score;
+        links.parent[j] = static_cast<std::int32_t>(i);
+        links.back[j] = back;
       }
     }
   }
-  if (std::all_of(best.begin(), best.end(), [](double b) { return b == kNoScore; })) return false;
+}
+
+bool HmmMatcher::apply(Step& next, const Links& links) {
+  if (std::all_of(links.best.begin(), links.best.end(), [](double b) { return b == kNoScore; })) return false;
   for (std::size_t j = 0; j < next.candidates.size(); ++j) {
     Candidate& c = next.candidates[j];
-    c.parent = parent[j];
-    c.score = best[j] == kNoScore ? kNoScore : c.score + best[j];
+    c.parent = links.parent[j];
+    c.back = links.back[j];
+    c.score = links.best[j] == kNoScore ? kNoScore : c.score + links.best[j];
   }
   // Keep the scores near zero: only their differences matter.
   const double top = next.candidates[HmmMatcher::best(next)].score;
@@ -121,6 +129,12 @@ bool HmmMatcher::link(const Step& prev, Step& next, const GpsFix& fix, planner::
     if (c.score != kNoScore) c.score -= top;
   }
   return true;
+}
+
+bool HmmMatcher::link(const Step& prev, Step& next, const GpsFix& fix, planner::BoundedDistances& distances) {
+  Links links(next.candidates.size());
+  relax(prev, next, fix, 0.0, 1, distances, links);
+  return apply(next, links);
 }
 
 std::size_t HmmMatcher::best(const Step& step) {
@@ -192,7 +206,8 @@ std::vector<MatchedPoint> HmmMatcher::match(std::span<const GpsFix> trace) {
   std::vector<MatchedPoint> out(trace.size());
   std::vector<Step> steps;
   std::vector<std::size_t> fix_of;  // steps[k] came from trace[fix_of[k]]
-  // Backtracks the chain steps[first..steps.size()) from its best last candidate.
+  // Backtracks the chain steps[first..steps.size()) from its best last candidate; the fixes
+  // between its steps that the path leaves out are outliers.
   auto finish_chain = [&](std::size_t first) {
     if (steps.size() <= first) return;
     std::size_t k = steps.size() - 1;
@@ -200,44 +215,49 @@ std::vector<MatchedPoint> HmmMatcher::match(std::span<const GpsFix> trace) {
     while (true) {
       out[fix_of[k]] = point_of(steps[k], static_cast<std::size_t>(at));
       if (k == first) break;
-      at = steps[k].candidates[static_cast<std::size_t>(at)].parent;
-      --k;
-      if (at < 0) break;  // cannot happen inside a chain; stop rather than misread
+      const Candidate& c = steps[k].candidates[static_cast<std::size_t>(at)];
+      if (c.parent < 0 || c.back > k - first) break;  // cannot happen inside a chain; stop rather than misread
+      k -= c.back;
+      at = c.parent;
     }
+    const std::size_t from = fix_of[first], to = fix_of.back();
+    for (std::size_t i = from; i <= to; ++i) out[i].outlier = !out[i].matched;
     if (config_.along_path != HmmConfig::AlongPath::smoothed) return;
-    std::vector<GpsFix> chain_fixes;
-    std::vector<MatchedPoint> chain_points;
-    for (std::size_t j = first; j < steps.size(); ++j) {
-      chain_fixes.push_back(trace[fix_of[j]]);
-      chain_points.push_back(out[fix_of[j]]);
-    }
+    std::vector<MatchedPoint> chain_points(out.begin() + static_cast<std::ptrdiff_t>(from),
+                                           out.begin() + static_cast<std::ptrdiff_t>(to + 1));
     SmootherConfig smoother;
     smoother.sigma_base_m = config_.sigma_base_m;
     smoother.default_hdop = config_.default_hdop;
-    const auto smoothed = smooth_along_path(graph_, distances, chain_fixes, chain_points, smoother);
-    for (std::size_t j = first; j < steps.size(); ++j) {
-      MatchedPoint& m = out[fix_of[j]];
-      m = smoothed[j - first];
-      m.distance_m = maps::distance_m(steps[j].raw, m.point);
+    const auto smoothed = smooth_along_path(graph_, distances, trace.subspan(from, to + 1 - from), chain_points, smoother);
+    for (std::size_t i = from; i <= to; ++i) {
+      MatchedPoint& m = out[i];
+      const bool outlier = m.outlier;
+      m = smoothed[i - from];
+      m.outlier = outlier;
+      if (m.matched) m.distance_m = maps::distance_m(graph_.projection().to_local(trace[i].position), m.point);
     }
   };
   std::size_t chain_first = 0;
-  std::size_t skipped = 0;  // fixes in a row that no candidate of the chain could reach
+  std::size_t skipped = 0;  // fixes in a row set aside because nothing in the chain reaches them
   for (std::size_t i = 0; i < trace.size(); ++i) {
     Step step;
     step.time_s = trace[i].time_s;
     step.raw = graph_.projection().to_local(trace[i].position);
     step.candidates = candidates_for(trace[i], step.raw);
-    if (step.candidates.empty()) {
-      finish_chain(chain_first);
-      chain_first = steps.size();
-      continue;  // out[i] stays unmatched
+    const bool in_chain = steps.size() > chain_first;
+    bool linked = false;
+    if (in_chain && !step.candidates.empty()) {
+      // From the last step, or over up to max_skipped steps before it, each left out as an outlier.
+      Links links(step.candidates.size());
+      for (std::size_t back = 1; back <= config_.max_skipped + 1 && steps.size() >= chain_first + back; ++back) {
+        relax(steps[steps.size() - back], step, trace[i], static_cast<double>(back - 1) * config_.outlier_penalty,
+              static_cast<std::uint8_t>(back), distances, links);
+      }
+      linked = apply(step, links);
     }
-    const bool linked = steps.size() > chain_first && link(steps.back(), step, trace[i], distances);
-    // A fix nothing in the chain can reach, between fixes that fit it, is an outlier (multipath):
-    // left unmatched rather than breaking the chain, at most max_skipped in a row.
-    if (!linked && steps.size() > chain_first && skipped < config_.max_skipped &&
-        trace[i].time_s - steps.back().time_s <= config_.gap_s) {
+    // A fix nothing in the chain can reach, or with no road near, between fixes that fit it, is an
+    // outlier (multipath): set aside rather than breaking the chain, at most max_skipped in a row.
+    if (!linked && in_chain && skipped < config_.max_skipped && trace[i].time_s - steps.back().time_s <= config_.gap_s) {
       ++skipped;
       continue;
     }
@@ -245,6 +265,7 @@ std::vector<MatchedPoint> HmmMatcher::match(std::span<const GpsFix> trace) {
     if (!linked) {
       finish_chain(chain_first);
       chain_first = steps.size();
+      if (step.candidates.empty()) continue;  // out[i] stays unmatched
       step.chain_start = true;  // scored by the emission alone
     }
     steps.push_back(std::move(step));

@@ -7,7 +7,9 @@
 // the chain, which restarts cleanly at the next fix.
 #pragma once
 
+#include <cstdint>
 #include <deque>
+#include <limits>
 #include <memory>
 #include <span>
 #include <vector>
@@ -32,9 +34,23 @@ struct HmmConfig {
   double gap_s = 60.0;            // fixes further apart in time break the chain
   double heading_sigma_deg = 40.0;
   double heading_min_speed_mps = 2.0;  // below this the course over ground is noise
-  double backward_tolerance_m = 8.0;   // noise may put a fix a little behind the last one on a road
+  // Noise may put a fix a little behind the last one on the same road: up to the larger of these
+  // is read as standing or creeping, not as a drive round the block. Two fixes' positions along a
+  // road differ by noise of σ√2, so 3σ lets through nearly all of it while the vehicle stands.
+  double backward_tolerance_m = 8.0;
+  double backward_sigmas = 3.0;
+  // A move straight back onto the road it came by (a U-turn at the node): rare in traffic, yet as
+  // cheap as standing still where a stopped vehicle's fixes scatter across a junction. Its price,
+  // as a log-likelihood.
+  double uturn_penalty = 4.0;
   std::size_t window = 8;         // online: steps kept (the lag bound)
-  std::size_t max_skipped = 2;    // batch: unreachable fixes in a row skipped as outliers before a break
+  // Batch: fixes in a row that may be set aside as outliers (multipath) before the chain breaks.
+  // A fix nothing reaches, or with no road near, is set aside outright; any other fix may be, if
+  // the path round it scores better by more than outlier_penalty (a log-likelihood: about the
+  // price of a 3.5σ emission) for each fix it leaves out. Set-aside fixes are placed on the path by
+  // the smoother, and flagged.
+  std::size_t max_skipped = 2;
+  double outlier_penalty = 6.0;
   // Batch: smooth each chain along its matched path (path_smoother.hpp), or leave each point
   // where its fix projects.
   enum class AlongPath { smoothed, projected } along_path = AlongPath::smoothed;
@@ -73,7 +89,8 @@ class HmmMatcher {
     maps::Point2 point;
     double distance_m;
     double score;         // log probability of the best path ending here
-    std::int32_t parent;  // index in the previous step, -1 at a chain start
+    std::int32_t parent;  // index in the step `back` steps earlier, -1 at a chain start
+    std::uint8_t back = 1;  // batch: more than 1 where the best path sets fixes aside as outliers
   };
   struct Step {
     double time_s;
@@ -84,6 +101,20 @@ class HmmMatcher {
 
   // Candidates of a fix with their emission scores.
   std::vector<Candidate> candidates_for(const GpsFix& fix, maps::Point2 raw) const;
+  // The best move found so far into each candidate of a step.
+  struct Links {
+    explicit Links(std::size_t n) : best(n, -std::numeric_limits<double>::infinity()), parent(n, -1), back(n, 1) {}
+    std::vector<double> best;
+    std::vector<std::int32_t> parent;
+    std::vector<std::uint8_t> back;
+  };
+  // Every move from `prev`'s candidates to `next`'s, each scored less `penalty`, kept in `links`
+  // where it beats the best so far.
+  void relax(const Step& prev, const Step& next, const GpsFix& fix, double penalty, std::uint8_t back,
+             planner::BoundedDistances& distances, Links& links) const;
+  // Gives `next` the scores and parents of `links`; false (and `next` untouched) when no candidate
+  // was reached.
+  static bool apply(Step& next, const Links& links);
   // Links `next` to `prev` (scores and parents); false when no candidate can be reached.
   bool link(const Step& prev, Step& next, const GpsFix& fix, planner::BoundedDistances& distances);
   [[nodiscard]] MatchedPoint point_of(const Step& step, std::size_t index) const;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 
 namespace corridor::localizer {
 namespace {
@@ -20,40 +21,49 @@ std::vector<MatchedPoint> smooth_along_path(const maps::RoadGraph& g, planner::B
                                             const SmootherConfig& config) {
   std::vector<MatchedPoint> out(points.begin(), points.end());
   const std::size_t n = points.size();
-  if (n < 3 || fixes.size() != n) return out;
+  if (n < 3 || fixes.size() != n || !points.front().matched || !points.back().matched) return out;
 
-  // 1. The path and each point's distance along it.
+  // 1. The path and each matched point's distance along it (NaN for a point without a match: an
+  // outlier the matcher set aside, placed by the filter alone).
   std::vector<Occurrence> path{{points[0].edge, 0.0}};
-  std::vector<double> s(n);
+  std::vector<double> s(n, std::numeric_limits<double>::quiet_NaN());
   s[0] = points[0].offset_m;
+  std::size_t last = 0;  // the last matched point
   for (std::size_t i = 1; i < n; ++i) {
-    const MatchedPoint& a = points[i - 1];
+    const MatchedPoint& a = points[last];
     const MatchedPoint& b = points[i];
+    if (!b.matched) continue;
     if (b.edge == a.edge && b.edge == path.back().edge) {
       s[i] = path.back().s_start + b.offset_m;  // along the same edge (a little back is noise)
-      continue;
+    } else {
+      distances.run(g, g.head(path.back().edge), 5000.0, std::array<NodeId, 1>{g.tail(b.edge)});
+      if (distances.length_m(g.tail(b.edge)) == planner::kInfCost) return out;
+      double at = path.back().s_start + g.length_m(path.back().edge);
+      for (EdgeId e : distances.path_to(g, g.tail(b.edge))) {
+        path.push_back({e, at});
+        at += g.length_m(e);
+      }
+      path.push_back({b.edge, at});
+      s[i] = at + b.offset_m;
     }
-    distances.run(g, g.head(path.back().edge), 5000.0, std::array<NodeId, 1>{g.tail(b.edge)});
-    if (distances.length_m(g.tail(b.edge)) == planner::kInfCost) return out;
-    double at = path.back().s_start + g.length_m(path.back().edge);
-    for (EdgeId e : distances.path_to(g, g.tail(b.edge))) {
-      path.push_back({e, at});
-      at += g.length_m(e);
-    }
-    path.push_back({b.edge, at});
-    s[i] = at + b.offset_m;
+    last = i;
   }
   // A path much longer than the fixes moved (a loop round a block where noise put a fix behind
   // the last one) would drag the estimate along it: the chain is smoothed in two parts there.
+  last = 0;
   for (std::size_t i = 1; i < n; ++i) {
-    const double dt = std::max(1.0, fixes[i].time_s - fixes[i - 1].time_s);
-    const double moved = maps::distance_m(points[i - 1].point, points[i].point);
-    if (std::abs(s[i] - s[i - 1]) > 2.0 * moved + 10.0 * dt) {
-      auto head = smooth_along_path(g, distances, fixes.first(i), points.first(i), config);
+    if (!points[i].matched) continue;
+    const double dt = std::max(1.0, fixes[i].time_s - fixes[last].time_s);
+    const double moved = maps::distance_m(points[last].point, points[i].point);
+    if (std::abs(s[i] - s[last]) > 2.0 * moved + 10.0 * dt) {
+      auto head = smooth_along_path(g, distances, fixes.first(last + 1), points.first(last + 1), config);
       const auto tail = smooth_along_path(g, distances, fixes.subspan(i), points.subspan(i), config);
+      // Points set aside between the two parts keep no estimate.
+      head.insert(head.end(), points.begin() + static_cast<std::ptrdiff_t>(last + 1), points.begin() + static_cast<std::ptrdiff_t>(i));
       head.insert(head.end(), tail.begin(), tail.end());
       return head;
     }
+    last = i;
   }
 
   // 2. Constant-velocity Kalman filter over (s, v), then the RTS smoother.
@@ -65,7 +75,7 @@ std::vector<MatchedPoint> smooth_along_path(const maps::RoadGraph& g, planner::B
   auto sigma_s = [&](std::size_t i) {
     return usable_hdop(fixes[i], config.default_hdop) * config.sigma_base_m;
   };
-  const double v0 = fixes[0].speed_mps.value_or(n > 1 && fixes[1].time_s > fixes[0].time_s
+  const double v0 = fixes[0].speed_mps.value_or(points[1].matched && fixes[1].time_s > fixes[0].time_s
                                                     ? (s[1] - s[0]) / (fixes[1].time_s - fixes[0].time_s)
                                                     : 0.0);
   xf[0] = {s[0], v0};
@@ -93,8 +103,10 @@ std::vector<MatchedPoint> smooth_along_path(const maps::RoadGraph& g, planner::B
       const double pr0 = p1[static_cast<std::size_t>(row * 2)], pr1 = p1[static_cast<std::size_t>(row * 2 + 1)];  // row of P
       p1 = {p1[0] - k0 * pr0, p1[1] - k0 * pr1, p1[2] - k1 * pr0, p1[3] - k1 * pr1};
     };
-    update(0, s[i], std::pow(sigma_s(i), 2));
-    if (fixes[i].speed_mps) update(1, *fixes[i].speed_mps, std::pow(config.speed_sigma_mps, 2));
+    if (points[i].matched) {
+      update(0, s[i], std::pow(sigma_s(i), 2));
+      if (fixes[i].speed_mps) update(1, *fixes[i].speed_mps, std::pow(config.speed_sigma_mps, 2));
+    }
     xf[i] = x1;
     pf[i] = p1;
   }
@@ -123,6 +135,7 @@ std::vector<MatchedPoint> smooth_along_path(const maps::RoadGraph& g, planner::B
     out[i].edge = o.edge;
     out[i].offset_m = std::clamp(at - o.s_start, 0.0, g.length_m(o.edge));
     out[i].point = g.point_along(o.edge, out[i].offset_m);
+    out[i].matched = true;
   }
   return out;
 }

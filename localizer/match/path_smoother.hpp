@@ -23,9 +23,10 @@ struct SmootherConfig {
   double default_hdop = 1.5;
 };
 
-// `points` is one unbroken chain matched from `fixes` (same length, every point matched). Returns
-// the smoothed points; where the path between two points cannot be rebuilt, the chain is returned
-// unchanged.
+// `points` is one unbroken chain matched from `fixes` (same length, first and last matched).
+// A point not matched in between (a fix the matcher set aside as an outlier) adds no measurement;
+// the filter places it on the path by its time, and it comes back matched. Returns the smoothed
+// points; where the path between two points cannot be rebuilt, the chain is returned unchanged.
 std::vector<MatchedPoint> smooth_along_path(const maps::RoadGraph& graph, planner::BoundedDistances& distances,
                                             std::span<const GpsFix> fixes, std::span<const MatchedPoint> points,
                                             const SmootherConfig& config = {});

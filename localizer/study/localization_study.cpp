@@ -1,8 +1,10 @@
 #include "localizer/study/localization_study.hpp"
 
 #include "localizer/match/bearing.hpp"
+#include "planner/bounded_search.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <numbers>
@@ -28,6 +30,10 @@ std::pair<EdgeId, double> nearest_agreeing(const maps::RoadGraph& g, const std::
 }
 
 constexpr auto kAnyEdge = [](EdgeId) { return true; };
+
+// The farthest apart that SUMO's junction joining puts OSM nodes of one junction
+// (netconvert --junctions.join-dist is 10 m; clusters chain a few of them).
+constexpr double kJunctionSpanM = 60.0;
 
 }  // namespace
 
@@ -80,18 +86,30 @@ std::vector<TrueEdges> true_edges(const maps::RoadGraph& g, const maps::EdgeSnap
       if (on_way.first.valid()) out[i].edge = on_way.first, out[i].from_lane = true;
     }
   }
-  // Inside a junction: the edge the vehicle came by, or the one it leaves by.
+  // Inside a junction: the edge the vehicle came by, the one it leaves by, or one between them.
+  // SUMO joins OSM nodes a few metres apart into one junction (a divided road's crossing); the
+  // OSM edges between those nodes lie inside it.
+  planner::BoundedDistances between(g.node_count());
   EdgeId before;
-  for (std::size_t i = 0; i < samples.size(); ++i) {
+  for (std::size_t i = 0; i < samples.size();) {
     if (in_junction[i] == 0) {
-      before = out[i].edge;
+      before = out[i++].edge;
       continue;
     }
     std::size_t j = i;
     while (j < samples.size() && in_junction[j] != 0) ++j;
     const EdgeId after = j < samples.size() ? out[j].edge : EdgeId{};
-    out[i].edge = before.valid() ? before : after;
-    out[i].alt = after;
+    std::vector<EdgeId> through;
+    if (before.valid() && after.valid() && before != after && g.head(before) != g.tail(after)) {
+      const NodeId to = g.tail(after);
+      between.run(g, g.head(before), kJunctionSpanM, std::array<NodeId, 1>{to});
+      through = between.path_to(g, to);
+    }
+    for (; i < j; ++i) {
+      out[i].edge = before.valid() ? before : after;
+      out[i].alt = after;
+      out[i].through = through;
+    }
   }
   return out;
 }

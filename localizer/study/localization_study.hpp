@@ -5,6 +5,8 @@
 // the road through the outage and recovers after it.
 #pragma once
 
+#include <algorithm>
+
 #include <cstdint>
 #include <map>
 #include <optional>
@@ -74,21 +76,25 @@ EdgeId true_edge(const maps::RoadGraph& graph, const maps::EdgeSnapper& snapper,
 // nothing for a lane inside a junction (":…") or an edge netconvert made up.
 std::optional<std::int64_t> sumo_lane_osm_way(const std::string& lane);
 
-// What a sample's vehicle truly drives: one edge, or, inside a SUMO junction, either of the edges
-// before and after it (the vehicle is between them).
+// What a sample's vehicle truly drives: one edge, or, inside a SUMO junction, the edges before and
+// after it and the OSM edges between them (the vehicle is somewhere on that way through).
 struct TrueEdges {
   EdgeId edge;
   EdgeId alt;
-  bool from_lane = false;  // the lane's way chose `edge`
-  EdgeId nearest;          // what true_edge() alone would say, for comparison
+  std::vector<EdgeId> through;  // inside a junction: the shortest way from `edge`'s head to `alt`'s tail
+  bool from_lane = false;       // the lane's way chose `edge`
+  EdgeId nearest;               // what true_edge() alone would say, for comparison
   [[nodiscard]] bool valid() const { return edge.valid(); }
-  [[nodiscard]] bool contains(EdgeId e) const { return e.valid() && (e == edge || e == alt); }
+  [[nodiscard]] bool contains(EdgeId e) const {
+    return e.valid() && (e == edge || e == alt || std::find(through.begin(), through.end(), e) != through.end());
+  }
 };
 
 // The true edges of a drive. A sample on a lane of OSM way W: the nearest edge of W whose
 // direction agrees with the heading within 90°, so a parallel road or a lane offset cannot fool
 // it, if it lies within 4 m more than true_edge()'s road (else SUMO's edge spans ways, and that
-// road stands); inside a junction: the edges before and after it; otherwise true_edge().
+// road stands); inside a junction: the edges before and after it and, where SUMO joined several
+// OSM nodes into one junction, the short OSM edges between them; otherwise true_edge().
 std::vector<TrueEdges> true_edges(const maps::RoadGraph& graph, const maps::EdgeSnapper& snapper,
                                   const std::vector<TruthSample>& samples, double radius_m);
 

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # `corridor match` as a user runs it: a GPX and a CSV trace on the embedded map give the JSON
-# contract (points, way_names, route, points_per_s); bad traces give a clear error and exit 1.
+# contract (points, way_names, route, points_per_s); a multipath fix is flagged as an outlier; bad
+# traces give a clear error and exit 1.
 # Usage: match_cli_test.sh CORRIDOR_BINARY
 set -uo pipefail
 corridor=$1
@@ -26,6 +27,10 @@ with open(f"{work}/trace.csv", "w") as f:
     f.write("time,lat,lon,hdop\n")
     for i, (x, y) in enumerate(pts):
         f.write(f"{i},{y + (0.00002 if i % 2 else -0.00002)},{x},1.0\n")
+with open(f"{work}/outlier.csv", "w") as f:  # fix 30 thrown 65 m north, as multipath does
+    f.write("time,lat,lon,hdop\n")
+    for i, (x, y) in enumerate(pts):
+        f.write(f"{i},{y + (0.000585 if i == 30 else 0.0)},{x},1.0\n")
 with open(f"{work}/trace.gpx", "w") as f:
     f.write('<?xml version="1.0"?><gpx version="1.1" xmlns="http://www.topografix.com/GPX/1/1"><trk><trkseg>')
     for i, (x, y) in enumerate(pts):
@@ -44,6 +49,16 @@ assert len(d['way_names']) >= 2 and all(a != b for a, b in zip(d['way_names'], d
 \""
   check "$kind: --out is a GeoJSON Feature" "python3 -c \"import json; assert json.load(open('$work/out.$kind.geojson'))['type'] == 'Feature'\""
 done
+
+# A multipath fix is set aside, flagged, and placed on the road where its neighbours put the vehicle.
+"$corridor" match --trace "$work/outlier.csv" --json > "$work/outlier.json" 2> "$work/err"
+check "outlier: exit 0" "[[ $? -eq 0 ]]"
+check "outlier: flagged and placed on the road" "python3 -c \"
+import json; p=json.load(open('$work/outlier.json'))['points']
+assert p[30]['outlier'] and p[30]['matched'] and p[30]['distance_m'] > 40, p[30]
+assert sum(x['outlier'] for x in p) == 1, [i for i, x in enumerate(p) if x['outlier']]
+assert all(x['matched'] for x in p)
+\""
 
 expect_error() {  # name, file content, message fragment
   printf '%s' "$2" > "$work/bad"

@@ -9,6 +9,7 @@
 #include <iostream>
 #include <numbers>
 #include <random>
+#include <string>
 
 #include "localizer/match/synthetic_trace.hpp"
 #include "tests/localizer/sketch_graph.hpp"
@@ -85,8 +86,16 @@ TEST(HmmMatcher, FollowsAUTurnOnATwoWayStreet) {
   for (int i = 1; i <= 20; ++i) trace.push_back(fix_at(g, 20 + i, {500.0 - i * 20.0, 2.0}, 270.0, 20.0));
   const auto matched = matcher.match(trace);
   auto heading_east = [&](const MatchedPoint& m) { return g.position(g.head(m.edge)).x_m > g.position(g.tail(m.edge)).x_m; };
-  for (int i = 0; i <= 18; ++i) EXPECT_TRUE(heading_east(matched[static_cast<std::size_t>(i)])) << i;
-  for (std::size_t i = 23; i < matched.size(); ++i) EXPECT_FALSE(heading_east(matched[i])) << i;
+  for (int i = 0; i <= 18; ++i) {
+    ASSERT_TRUE(matched[static_cast<std::size_t>(i)].matched) << i;
+    EXPECT_TRUE(heading_east(matched[static_cast<std::size_t>(i)])) << i;
+  }
+  // The turn is mid-block, where the graph has no way round: the chain breaks there and the
+  // westward one starts within four fixes of it.
+  for (std::size_t i = 24; i < matched.size(); ++i) {
+    ASSERT_TRUE(matched[i].matched) << i;
+    EXPECT_FALSE(heading_east(matched[i])) << i;
+  }
 }
 
 // A one-way roundabout (radius 30 m, counter-clockwise) with four arms: the vehicle enters from the
@@ -141,17 +150,27 @@ TEST(HmmMatcher, AGapOrNothingNearBreaksTheChainAndItRestarts) {
   std::vector<GpsFix> trace;
   for (int i = 0; i < 5; ++i) trace.push_back(fix_at(g, i, {100.0 + i * 10, 1.0}));
   trace.push_back(fix_at(g, 5, {150, 900}));            // nothing within reach
-  trace.push_back(fix_at(g, 6, {160, 1.0}));            // starts a new chain
+  trace.push_back(fix_at(g, 6, {160, 1.0}));            // online: starts a new chain
   trace.push_back(fix_at(g, 300, {170, 1.0}));          // a 294 s gap
   trace.push_back(fix_at(g, 301, {180, 1.0}));
+  for (int i = 0; i < 3; ++i) trace.push_back(fix_at(g, 302 + i, {190.0 + i * 10, 900}));  // nothing, three times
+  trace.push_back(fix_at(g, 305, {220, 1.0}));                                           // a new chain
+  trace.push_back(fix_at(g, 306, {230, 1.0}));
   const auto m = matcher.match(trace);
   EXPECT_TRUE(m[0].chain_start);
   EXPECT_FALSE(m[4].chain_start);
-  EXPECT_FALSE(m[5].matched);
-  EXPECT_TRUE(m[6].matched && m[6].chain_start);
+  // Batch: one fix with nothing near, between fixes that fit, is a multipath outlier, set aside
+  // and placed on the road by its neighbours, not a break.
+  EXPECT_TRUE(m[5].matched && m[5].outlier);
+  EXPECT_NEAR(m[5].point.x_m, 150.0, 3.0);
+  EXPECT_TRUE(m[6].matched && !m[6].chain_start && !m[6].outlier);
   EXPECT_TRUE(m[7].matched && m[7].chain_start);
   EXPECT_TRUE(m[8].matched && !m[8].chain_start);
-  // Online the same.
+  // More than max_skipped such fixes in a row break the chain.
+  for (int i = 9; i <= 11; ++i) EXPECT_FALSE(m[static_cast<std::size_t>(i)].matched) << i;
+  EXPECT_TRUE(m[12].matched && m[12].chain_start);
+  EXPECT_TRUE(m[13].matched && !m[13].chain_start);
+  // Online, which must answer at once, breaks at the first.
   HmmMatcher online(g, snapper);
   std::vector<MatchedPoint> live;
   for (const GpsFix& f : trace) live.push_back(online.update(f));
@@ -159,6 +178,73 @@ TEST(HmmMatcher, AGapOrNothingNearBreaksTheChainAndItRestarts) {
   EXPECT_TRUE(live[6].chain_start);
   EXPECT_TRUE(live[7].chain_start);
   EXPECT_FALSE(live[8].chain_start);
+}
+
+// A multipath fix lands on the top of a block beside the main road, where a drive round the block
+// could just reach it between two fixes. The path round it, less the price of one outlier, beats
+// the detour: the fix is set aside and placed on the main road where the vehicle was.
+TEST(HmmMatcher, SetsAsideAMultipathFixThatOnlyADetourCouldReach) {
+  Sketch s;
+  s.nodes = {{0, 0}, {500, 0}, {560, 0}, {1200, 0}, {500, 40}, {560, 40}};
+  s.roads = {{{0, 1, 2, 3}, false, 1}, {{1, 4, 5, 2}, false, 2}};
+  const auto g = s.build();
+  const maps::EdgeSnapper snapper(g);
+  std::vector<GpsFix> trace;
+  for (int i = 0; i <= 12; ++i) {
+    const double x = 300.0 + i * 50.0;  // 10 m/s, a fix every 5 s
+    trace.push_back(fix_at(g, i * 5.0, i == 5 ? maps::Point2{530, 40} : maps::Point2{x, 0.5}, 90.0, 10.0));
+  }
+  const auto m = HmmMatcher(g, snapper).match(trace);
+  EXPECT_TRUE(m[5].matched && m[5].outlier);
+  EXPECT_EQ(way_of(g, m[5]), 1);
+  EXPECT_NEAR(m[5].point.x_m, 550.0, 10.0);
+  for (std::size_t i = 0; i < m.size(); ++i) {
+    EXPECT_EQ(way_of(g, m[i]), 1) << i;
+    if (i != 5) {
+      EXPECT_FALSE(m[i].outlier) << i;
+    }
+  }
+  // Without the price of an outlier (never worth it), the matcher drives round the block.
+  HmmConfig never;
+  never.outlier_penalty = 1e9;
+  EXPECT_EQ(way_of(g, HmmMatcher(g, snapper, never).match(trace)[5]), 2);
+}
+
+// A vehicle waits 5 m before a junction; its fixes scatter by σ 5 m, some of them well behind
+// the one before (more than a fixed tolerance of 8 m). Standing still is the explanation, not a
+// U-turn or the side street: every fix stays on the approach, in the direction it came.
+TEST(HmmMatcher, AVehicleWaitingAtAJunctionStaysOnItsApproach) {
+  Sketch s;
+  s.nodes = {{0, 0}, {200, 0}, {400, 0}, {200, 25}, {200, -150}};
+  s.roads = {{{0, 1, 2}, false, 1}, {{3, 1, 4}, false, 2}};
+  const auto g = s.build();
+  const maps::EdgeSnapper snapper(g);
+  std::vector<GpsFix> trace;
+  for (int i = 0; i < 15; ++i) trace.push_back(fix_at(g, i, {50.0 + i * 10.0, 0.0}, 90.0, 10.0));
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> noise(0.0, 5.0);
+  int behind = 0;
+  double last_x = 190.0;
+  for (int i = 15; i < 60; ++i) {
+    const maps::Point2 p{195.0 + noise(rng), noise(rng)};
+    behind += p.x_m < last_x - 8.0 ? 1 : 0;
+    last_x = p.x_m;
+    GpsFix f = fix_at(g, i, p, std::nullopt, 0.0);
+    f.hdop = 1.25;  // σ 5 m with the default base of 4 m
+    trace.push_back(f);
+  }
+  ASSERT_GE(behind, 3);  // the case needs fixes well behind the last
+  auto on_approach = [&](const MatchedPoint& m) {
+    return m.matched && g.osm_way(m.edge).v == 1 && g.position(g.tail(m.edge)).x_m < g.position(g.head(m.edge)).x_m;
+  };
+  const auto batch = HmmMatcher(g, snapper).match(trace);
+  for (std::size_t i = 15; i < batch.size(); ++i) EXPECT_TRUE(on_approach(batch[i])) << i;
+  // Online, each answer is the best guess at once, before the next fix can show that a jump onto
+  // the side street was noise: most, not all.
+  HmmMatcher online(g, snapper);
+  int online_on = 0;
+  for (const GpsFix& f : trace) online_on += on_approach(online.update(f)) ? 1 : 0;
+  EXPECT_GE(online_on, 15 + 40);
 }
 
 TEST(HmmMatcher, RejectsUnsortedTimesAndNonFiniteFixes) {

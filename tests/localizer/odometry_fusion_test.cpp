@@ -316,5 +316,31 @@ TEST(LocalizationStudy, TrueEdgesFollowTheLaneWayAndSpanAJunction) {
   EXPECT_EQ(truth[3].edge, edge_between(g, {-300, 4}, {-10, 4}));  // no lane: the nearest road
 }
 
+// SUMO joins OSM nodes a few metres apart into one junction (a divided road's crossing): a vehicle
+// inside it may be on the short OSM edge between them, which is then part of the truth too; a
+// parallel street beside it is not.
+TEST(LocalizationStudy, AJoinedJunctionCountsTheShortEdgesInsideIt) {
+  Sketch s;
+  s.nodes = {{-300, 0}, {0, 0}, {8, 0}, {300, 0}, {0, -100}, {8, 100}};
+  s.roads = {{{0, 1}, false, 1}, {{1, 2}, false, 5}, {{2, 3}, false, 2}, {{4, 1}, false, 3}, {{2, 5}, false, 4}};
+  const auto g = s.build();
+  const maps::EdgeSnapper snapper(g);
+  auto sample = [&](double x, double y, const char* lane) {
+    TruthSample t;
+    t.position = g.projection().to_lat_lon({x, y});
+    t.heading_deg = 90.0;
+    t.lane = lane;
+    return t;
+  };
+  const std::vector<TruthSample> drive = {sample(-50, 0, "1_0"), sample(4, 0, ":cluster_2_3_0_0"), sample(50, 0, "2_0")};
+  const auto truth = true_edges(g, snapper, drive, 20.0);
+  EXPECT_TRUE(truth[1].contains(edge_between(g, {-300, 0}, {0, 0})));
+  EXPECT_TRUE(truth[1].contains(edge_between(g, {0, 0}, {8, 0})));
+  EXPECT_TRUE(truth[1].contains(edge_between(g, {8, 0}, {300, 0})));
+  EXPECT_FALSE(truth[1].contains(edge_between(g, {8, 0}, {0, 0})));   // the way back
+  EXPECT_FALSE(truth[1].contains(edge_between(g, {8, 0}, {8, 100})));  // a street leaving the junction
+  EXPECT_FALSE(truth[0].contains(edge_between(g, {0, 0}, {8, 0})));    // outside it, one edge
+}
+
 }  // namespace
 }  // namespace corridor::localizer
