@@ -251,7 +251,9 @@ describe('dispatch console (Monaco)', () => {
     const { page } = dispatcher;
     const current = (await api(server.url, 'GET', `/v1/missions/${missionId}`)).json;
     const coords = current.route.geometry.coordinates;
-    const target = current.preemption.find((e) => e.state !== 'released') ?? current.preemption[0];
+    // A signal still ahead on the route: one the reroute left behind is cancelled and never starts.
+    const target = current.preemption.find((e) => e.state === 'planned' || e.state === 'active');
+    assert.ok(target, `a planned preemption on the route: ${JSON.stringify(current.preemption.map((e) => e.state))}`);
     const at = [target.location.lon, target.location.lat];
     let k = 0;
     coords.forEach((c, i) => {
