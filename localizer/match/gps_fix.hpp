@@ -32,8 +32,10 @@ struct MatchedPoint {
   double distance_m = 0;     // from the raw fix to `point`
   double confidence = 0;     // the chosen candidate's share of the step's probability, 0..1
   bool chain_start = false;  // the first point after a break (gap, no candidate, impossible move)
-  // Batch only: the fix was set aside as an outlier (multipath); `point` is where the rest of its
-  // chain puts the vehicle at the fix's time, and `matched` is true if the chain could place it.
+  // Batch only: the fix, between two matched ones of its chain, was set aside as an outlier
+  // (multipath). If `matched`, `point` is where the smoothed chain puts the vehicle at the fix's
+  // time; without smoothing it stays unmatched. Fixes set aside at a chain's end, before a break,
+  // stay unmatched and unflagged.
   bool outlier = false;
 };
 

@@ -18,8 +18,10 @@ void HmmConfig::validate() const {
   if (!(sigma_base_m > 0.0) || !(default_hdop > 0.0) || !(beta_m > 0.0) || !(min_radius_m > 0.0) ||
       !(max_radius_m >= min_radius_m) || !(max_speed_mps > 0.0) || !(gap_s > 0.0) || !(backward_tolerance_m >= 0.0) || !(backward_sigmas >= 0.0) ||
       !(uturn_penalty >= 0.0) || !(outlier_penalty >= 0.0) || !(heading_sigma_deg > 0.0) ||
-      max_candidates == 0 || window == 0) {
-    throw std::invalid_argument("map matcher configuration needs positive scales, radii, speed, gap and window");
+      max_candidates == 0 || window == 0 || max_skipped > 16) {
+    throw std::invalid_argument(
+        "map matcher configuration needs positive scales, radii, speed, gap and window, non-negative penalties, "
+        "and at most 16 fixes set aside in a row");
   }
 }
 
@@ -59,7 +61,7 @@ std::vector<HmmMatcher::Candidate> HmmMatcher::candidates_for(const GpsFix& fix,
 }
 
 void HmmMatcher::relax(const Step& prev, const Step& next, const GpsFix& fix, double penalty, std::uint8_t back,
-                       planner::BoundedDistances& distances, Links& links) const {
+                       double base, planner::BoundedDistances& distances, Links& links) const {
   const double dt = next.time_s - prev.time_s;
   if (dt > config_.gap_s || dt < 0.0) return;
   const double straight = maps::distance_m(prev.raw, next.raw);
@@ -105,7 +107,7 @@ void HmmMatcher::relax(const Step& prev, const Step& next, const GpsFix& fix, do
       double transition = use_speed ? -std::abs(route - straight) / (2.0 * beta) - std::abs(route - *fix.speed_mps * dt) / beta
                                      : -std::abs(route - straight) / beta;
       if (c.edge == graph_.twin(p.edge) && c.edge != p.edge) transition -= config_.uturn_penalty;
-      const double score = p.score + transition - penalty;
+      const double score = p.score + (prev.norm - base) + transition - penalty;
       if (score > links.best[j]) {
         links.best[j] = score;
         links.parent[j] = static_cast<std::int32_t>(i);
@@ -115,7 +117,7 @@ void HmmMatcher::relax(const Step& prev, const Step& next, const GpsFix& fix, do
   }
 }
 
-bool HmmMatcher::apply(Step& next, const Links& links) {
+bool HmmMatcher::apply(Step& next, const Links& links, double base) {
   if (std::all_of(links.best.begin(), links.best.end(), [](double b) { return b == kNoScore; })) return false;
   for (std::size_t j = 0; j < next.candidates.size(); ++j) {
     Candidate& c = next.candidates[j];
@@ -128,13 +130,14 @@ bool HmmMatcher::apply(Step& next, const Links& links) {
   for (Candidate& c : next.candidates) {
     if (c.score != kNoScore) c.score -= top;
   }
+  next.norm = base + top;
   return true;
 }
 
 bool HmmMatcher::link(const Step& prev, Step& next, const GpsFix& fix, planner::BoundedDistances& distances) {
   Links links(next.candidates.size());
-  relax(prev, next, fix, 0.0, 1, distances, links);
-  return apply(next, links);
+  relax(prev, next, fix, 0.0, 1, prev.norm, distances, links);
+  return apply(next, links, prev.norm);
 }
 
 std::size_t HmmMatcher::best(const Step& step) {
@@ -248,12 +251,16 @@ std::vector<MatchedPoint> HmmMatcher::match(std::span<const GpsFix> trace) {
     bool linked = false;
     if (in_chain && !step.candidates.empty()) {
       // From the last step, or over up to max_skipped steps before it, each left out as an outlier.
+      // Fixes already set aside since a step count towards the limit on outliers in a row.
       Links links(step.candidates.size());
+      const double base = steps.back().norm;
       for (std::size_t back = 1; back <= config_.max_skipped + 1 && steps.size() >= chain_first + back; ++back) {
-        relax(steps[steps.size() - back], step, trace[i], static_cast<double>(back - 1) * config_.outlier_penalty,
-              static_cast<std::uint8_t>(back), distances, links);
+        const std::size_t from = steps.size() - back;
+        if (i - fix_of[from] - 1 > config_.max_skipped) break;
+        relax(steps[from], step, trace[i], static_cast<double>(back - 1) * config_.outlier_penalty,
+              static_cast<std::uint8_t>(back), base, distances, links);
       }
-      linked = apply(step, links);
+      linked = apply(step, links, base);
     }
     // A fix nothing in the chain can reach, or with no road near, between fixes that fit it, is an
     // outlier (multipath): set aside rather than breaking the chain, at most max_skipped in a row.

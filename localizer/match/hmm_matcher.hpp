@@ -4,7 +4,9 @@
 // candidates (the planner's bounded one-to-many search) with the straight-line distance between
 // the fixes. Heading and speed, when a fix has them, weigh candidates and moves. Viterbi runs
 // incrementally, keeping a bounded window; a time gap, no candidate, or no possible move breaks
-// the chain, which restarts cleanly at the next fix.
+// the chain, which restarts cleanly at the next fix. In batch, a few fixes in a row may instead be
+// set aside as outliers (max_skipped), where the fixes after them fit the chain; a time gap, or
+// more than that, still breaks it.
 #pragma once
 
 #include <cstdint>
@@ -44,11 +46,12 @@ struct HmmConfig {
   // as a log-likelihood.
   double uturn_penalty = 4.0;
   std::size_t window = 8;         // online: steps kept (the lag bound)
-  // Batch: fixes in a row that may be set aside as outliers (multipath) before the chain breaks.
-  // A fix nothing reaches, or with no road near, is set aside outright; any other fix may be, if
-  // the path round it scores better by more than outlier_penalty (a log-likelihood: about the
-  // price of a 3.5σ emission) for each fix it leaves out. Set-aside fixes are placed on the path by
-  // the smoother, and flagged.
+  // Batch: fixes in a row that may be set aside as outliers (multipath) before the chain breaks
+  // (at most 16). A fix nothing reaches, or with no road near, is set aside outright; any other
+  // fix may be, if the path round it scores better by more than outlier_penalty (a
+  // log-likelihood: about the price of a 3.5σ emission) for each fix it leaves out. Set-aside
+  // fixes between a chain's matched ones are flagged, and placed on the path by the smoother
+  // (unless along_path is projected, when they stay unmatched).
   std::size_t max_skipped = 2;
   double outlier_penalty = 6.0;
   // Batch: smooth each chain along its matched path (path_smoother.hpp), or leave each point
@@ -97,6 +100,9 @@ class HmmMatcher {
     maps::Point2 raw;
     std::vector<Candidate> candidates;
     bool chain_start = false;
+    // Candidates' scores are kept near zero; a score plus its step's `norm` is the log probability
+    // on the chain's common scale, which skip arcs over several steps compare.
+    double norm = 0.0;
   };
 
   // Candidates of a fix with their emission scores.
@@ -109,12 +115,13 @@ class HmmMatcher {
     std::vector<std::uint8_t> back;
   };
   // Every move from `prev`'s candidates to `next`'s, each scored less `penalty`, kept in `links`
-  // where it beats the best so far.
-  void relax(const Step& prev, const Step& next, const GpsFix& fix, double penalty, std::uint8_t back,
+  // where it beats the best so far. Scores in `links` are on the scale of the step whose norm is
+  // `base`.
+  void relax(const Step& prev, const Step& next, const GpsFix& fix, double penalty, std::uint8_t back, double base,
              planner::BoundedDistances& distances, Links& links) const;
-  // Gives `next` the scores and parents of `links`; false (and `next` untouched) when no candidate
-  // was reached.
-  static bool apply(Step& next, const Links& links);
+  // Gives `next` the scores and parents of `links` (on the scale of `base`); false (and `next`
+  // untouched) when no candidate was reached.
+  static bool apply(Step& next, const Links& links, double base);
   // Links `next` to `prev` (scores and parents); false when no candidate can be reached.
   bool link(const Step& prev, Step& next, const GpsFix& fix, planner::BoundedDistances& distances);
   [[nodiscard]] MatchedPoint point_of(const Step& step, std::size_t index) const;

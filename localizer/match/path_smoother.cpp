@@ -58,7 +58,7 @@ std::vector<MatchedPoint> smooth_along_path(const maps::RoadGraph& g, planner::B
     if (std::abs(s[i] - s[last]) > 2.0 * moved + 10.0 * dt) {
       auto head = smooth_along_path(g, distances, fixes.first(last + 1), points.first(last + 1), config);
       const auto tail = smooth_along_path(g, distances, fixes.subspan(i), points.subspan(i), config);
-      // Points set aside between the two parts keep no estimate.
+      // Points set aside between the two parts keep no estimate (the path between is in doubt).
       head.insert(head.end(), points.begin() + static_cast<std::ptrdiff_t>(last + 1), points.begin() + static_cast<std::ptrdiff_t>(i));
       head.insert(head.end(), tail.begin(), tail.end());
       return head;
@@ -75,8 +75,10 @@ std::vector<MatchedPoint> smooth_along_path(const maps::RoadGraph& g, planner::B
   auto sigma_s = [&](std::size_t i) {
     return usable_hdop(fixes[i], config.default_hdop) * config.sigma_base_m;
   };
-  const double v0 = fixes[0].speed_mps.value_or(points[1].matched && fixes[1].time_s > fixes[0].time_s
-                                                    ? (s[1] - s[0]) / (fixes[1].time_s - fixes[0].time_s)
+  std::size_t second = 1;  // the first matched point after the start
+  while (!points[second].matched) ++second;
+  const double v0 = fixes[0].speed_mps.value_or(fixes[second].time_s > fixes[0].time_s
+                                                    ? (s[second] - s[0]) / (fixes[second].time_s - fixes[0].time_s)
                                                     : 0.0);
   xf[0] = {s[0], v0};
   pf[0] = {std::pow(sigma_s(0), 2), 0.0, 0.0, fixes[0].speed_mps ? std::pow(config.speed_sigma_mps, 2) : 25.0};

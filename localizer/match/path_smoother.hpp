@@ -25,7 +25,8 @@ struct SmootherConfig {
 
 // `points` is one unbroken chain matched from `fixes` (same length, first and last matched).
 // A point not matched in between (a fix the matcher set aside as an outlier) adds no measurement;
-// the filter places it on the path by its time, and it comes back matched. Returns the smoothed
+// the filter places it on the path by its time, and it comes back matched (except between the two
+// parts of a chain split at a loop, where it stays unmatched). Returns the smoothed
 // points; where the path between two points cannot be rebuilt, the chain is returned unchanged.
 std::vector<MatchedPoint> smooth_along_path(const maps::RoadGraph& graph, planner::BoundedDistances& distances,
                                             std::span<const GpsFix> fixes, std::span<const MatchedPoint> points,

@@ -92,6 +92,9 @@ TEST(HmmMatcher, FollowsAUTurnOnATwoWayStreet) {
   }
   // The turn is mid-block, where the graph has no way round: the chain breaks there and the
   // westward one starts within four fixes of it.
+  bool restarted = false;
+  for (std::size_t i = 19; i <= 24; ++i) restarted = restarted || (matched[i].matched && matched[i].chain_start);
+  EXPECT_TRUE(restarted);
   for (std::size_t i = 24; i < matched.size(); ++i) {
     ASSERT_TRUE(matched[i].matched) << i;
     EXPECT_FALSE(heading_east(matched[i])) << i;
@@ -208,6 +211,27 @@ TEST(HmmMatcher, SetsAsideAMultipathFixThatOnlyADetourCouldReach) {
   HmmConfig never;
   never.outlier_penalty = 1e9;
   EXPECT_EQ(way_of(g, HmmMatcher(g, snapper, never).match(trace)[5]), 2);
+}
+
+// A fix 28 m off the only road (7σ): following it costs its emission, not its moves, which fit.
+// Skip arcs weigh the whole path through it, on one scale across steps, against the price of an
+// outlier: it is set aside (a comparison of the moves alone would keep it).
+TEST(HmmMatcher, SetsAsideAFixFarFromTheRoadEvenWhenItsMovesFit) {
+  Sketch s;
+  s.nodes = {{0, 0}, {2000, 0}};
+  s.roads = {{{0, 1}, false, 1}};
+  const auto g = s.build();
+  const maps::EdgeSnapper snapper(g);
+  std::vector<GpsFix> trace;
+  for (int i = 0; i <= 12; ++i) trace.push_back(fix_at(g, i * 5.0, {300.0 + i * 50.0, i == 5 ? 28.0 : 0.5}, 90.0, 10.0));
+  const auto m = HmmMatcher(g, snapper).match(trace);
+  EXPECT_TRUE(m[5].matched && m[5].outlier);
+  EXPECT_NEAR(m[5].point.x_m, 550.0, 5.0);
+  for (std::size_t i = 0; i < m.size(); ++i) {
+    if (i != 5) {
+      EXPECT_TRUE(m[i].matched && !m[i].outlier) << i;
+    }
+  }
 }
 
 // A vehicle waits 5 m before a junction; its fixes scatter by σ 5 m, some of them well behind
