@@ -288,6 +288,15 @@ TEST(LocalizationStudy, ReadsTheOsmWayOfASumoLane) {
   EXPECT_FALSE(sumo_lane_osm_way(""));
 }
 
+// A SUMO sample at (x, y) in the local frame, heading east, on `lane`.
+TruthSample eastward_sample(const maps::RoadGraph& g, double x, double y, const char* lane) {
+  TruthSample t;
+  t.position = g.projection().to_lat_lon({x, y});
+  t.heading_deg = 90.0;
+  t.lane = lane;
+  return t;
+}
+
 // The oracle: a lane of way 1 names that way's edge even where way 3 runs nearer, and inside a
 // junction either the edge before it or the one after it is the truth.
 TEST(LocalizationStudy, TrueEdgesFollowTheLaneWayAndSpanAJunction) {
@@ -298,13 +307,7 @@ TEST(LocalizationStudy, TrueEdgesFollowTheLaneWayAndSpanAJunction) {
   s.roads = {{{0, 1}, false, 1}, {{1, 2}, false, 2}, {{3, 4}, false, 3}, {{4, 1}, false, 4}};
   const auto g = s.build();
   const maps::EdgeSnapper snapper(g);
-  auto sample = [&](double x, double y, const char* lane) {
-    TruthSample t;
-    t.position = g.projection().to_lat_lon({x, y});
-    t.heading_deg = 90.0;
-    t.lane = lane;
-    return t;
-  };
+  auto sample = [&](double x, double y, const char* lane) { return eastward_sample(g, x, y, lane); };
   const std::vector<TruthSample> drive = {sample(-100, 3.5, "1_0"), sample(-1, 0, ":J_0_0"), sample(100, 0, "2_0"),
                                           sample(-50, 3.9, "")};
   const auto truth = true_edges(g, snapper, drive, 20.0);
@@ -317,21 +320,15 @@ TEST(LocalizationStudy, TrueEdgesFollowTheLaneWayAndSpanAJunction) {
 }
 
 // SUMO joins OSM nodes a few metres apart into one junction (a divided road's crossing): a vehicle
-// inside it may be on the short OSM edge between them, which is then part of the truth too; a
-// parallel street beside it is not.
+// inside it may be on the short OSM edge between them, which is then part of the truth too; the
+// way back and a street leaving the junction are not.
 TEST(LocalizationStudy, AJoinedJunctionCountsTheShortEdgesInsideIt) {
   Sketch s;
   s.nodes = {{-300, 0}, {0, 0}, {8, 0}, {300, 0}, {0, -100}, {8, 100}};
   s.roads = {{{0, 1}, false, 1}, {{1, 2}, false, 5}, {{2, 3}, false, 2}, {{4, 1}, false, 3}, {{2, 5}, false, 4}};
   const auto g = s.build();
   const maps::EdgeSnapper snapper(g);
-  auto sample = [&](double x, double y, const char* lane) {
-    TruthSample t;
-    t.position = g.projection().to_lat_lon({x, y});
-    t.heading_deg = 90.0;
-    t.lane = lane;
-    return t;
-  };
+  auto sample = [&](double x, double y, const char* lane) { return eastward_sample(g, x, y, lane); };
   const std::vector<TruthSample> drive = {sample(-50, 0, "1_0"), sample(4, 0, ":cluster_2_3_0_0"), sample(50, 0, "2_0")};
   const auto truth = true_edges(g, snapper, drive, 20.0);
   EXPECT_TRUE(truth[1].contains(edge_between(g, {-300, 0}, {0, 0})));
