@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 
@@ -60,6 +61,13 @@ std::vector<HmmMatcher::Candidate> HmmMatcher::candidates_for(const GpsFix& fix,
   return out;
 }
 
+HmmMatcher::Links::Links(const maps::RoadGraph& graph, const std::vector<Candidate>& next)
+    : best(next.size(), kNoScore), parent(next.size(), -1), back(next.size(), 1) {
+  for (const Candidate& c : next) targets.push_back(graph.tail(c.edge));
+  std::sort(targets.begin(), targets.end());
+  targets.erase(std::unique(targets.begin(), targets.end()), targets.end());
+}
+
 void HmmMatcher::relax(const Step& prev, const Step& next, const GpsFix& fix, double penalty, std::uint8_t back,
                        double base, planner::BoundedDistances& distances, Links& links) const {
   const double dt = next.time_s - prev.time_s;
@@ -68,11 +76,6 @@ void HmmMatcher::relax(const Step& prev, const Step& next, const GpsFix& fix, do
   // No route can be longer than the fastest vehicle drives meanwhile; a generous detour budget
   // keeps the searches small where fixes are dense.
   const double bound = std::min(config_.max_speed_mps * std::max(dt, 1.0), 2.0 * straight + 300.0);
-  thread_local std::vector<NodeId> targets;
-  targets.clear();
-  for (const Candidate& c : next.candidates) targets.push_back(graph_.tail(c.edge));
-  std::sort(targets.begin(), targets.end());
-  targets.erase(std::unique(targets.begin(), targets.end()), targets.end());
   const bool use_speed = fix.speed_mps && std::isfinite(*fix.speed_mps) && dt > 0.0;
   // Both distances come from noisy fixes (projected onto the road, or straight between them), so
   // their difference spreads with the GPS noise: the scale grows with σ, never below beta_m.
@@ -92,7 +95,7 @@ void HmmMatcher::relax(const Step& prev, const Step& next, const GpsFix& fix, do
         route = std::max(0.0, c.offset_m - p.offset_m);
       } else {
         if (!searched) {
-          distances.run(graph_, graph_.head(p.edge), std::max(0.0, bound - to_end), targets);
+          distances.run(graph_, graph_.head(p.edge), std::max(0.0, bound - to_end), links.targets);
           searched = true;
         }
         const double between = distances.length_m(graph_.tail(c.edge));
@@ -106,7 +109,7 @@ void HmmMatcher::relax(const Step& prev, const Step& next, const GpsFix& fix, do
       // is σ√2 a side, and all of it at a stop), so the speed term gets the tighter scale.
       double transition = use_speed ? -std::abs(route - straight) / (2.0 * beta) - std::abs(route - *fix.speed_mps * dt) / beta
                                      : -std::abs(route - straight) / beta;
-      if (c.edge == graph_.twin(p.edge) && c.edge != p.edge) transition -= config_.uturn_penalty;
+      if (c.edge == graph_.twin(p.edge)) transition -= config_.uturn_penalty;
       const double score = p.score + (prev.norm - base) + transition - penalty;
       if (score > links.best[j]) {
         links.best[j] = score;
@@ -135,7 +138,7 @@ bool HmmMatcher::apply(Step& next, const Links& links, double base) {
 }
 
 bool HmmMatcher::link(const Step& prev, Step& next, const GpsFix& fix, planner::BoundedDistances& distances) {
-  Links links(next.candidates.size());
+  Links links(graph_, next.candidates);
   relax(prev, next, fix, 0.0, 1, prev.norm, distances, links);
   return apply(next, links, prev.norm);
 }
@@ -252,7 +255,7 @@ std::vector<MatchedPoint> HmmMatcher::match(std::span<const GpsFix> trace) {
     if (in_chain && !step.candidates.empty()) {
       // From the last step, or over up to max_skipped steps before it, each left out as an outlier.
       // Fixes already set aside since a step count towards the limit on outliers in a row.
-      Links links(step.candidates.size());
+      Links links(graph_, step.candidates);
       const double base = steps.back().norm;
       for (std::size_t back = 1; back <= config_.max_skipped + 1 && steps.size() >= chain_first + back; ++back) {
         const std::size_t from = steps.size() - back;

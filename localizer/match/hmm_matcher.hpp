@@ -11,7 +11,6 @@
 
 #include <cstdint>
 #include <deque>
-#include <limits>
 #include <memory>
 #include <span>
 #include <vector>
@@ -107,12 +106,14 @@ class HmmMatcher {
 
   // Candidates of a fix with their emission scores.
   std::vector<Candidate> candidates_for(const GpsFix& fix, maps::Point2 raw) const;
-  // The best move found so far into each candidate of a step.
+  // The best move found so far into each candidate of a step, and the nodes the moves' searches
+  // must settle (its candidates' edge tails, once for every earlier step they are relaxed from).
   struct Links {
-    explicit Links(std::size_t n) : best(n, -std::numeric_limits<double>::infinity()), parent(n, -1), back(n, 1) {}
+    Links(const maps::RoadGraph& graph, const std::vector<Candidate>& next);
     std::vector<double> best;
     std::vector<std::int32_t> parent;
     std::vector<std::uint8_t> back;
+    std::vector<NodeId> targets;
   };
   // Every move from `prev`'s candidates to `next`'s, each scored less `penalty`, kept in `links`
   // where it beats the best so far. Scores in `links` are on the scale of the step whose norm is
