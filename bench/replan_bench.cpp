@@ -11,6 +11,8 @@
 #include <unordered_set>
 
 #include "maps/progress.hpp"
+#include "planner/cch_metric.hpp"
+#include "planner/cch_topology.hpp"
 #include "planner/cost_overlay.hpp"
 #include "planner/dstar_lite.hpp"
 #include "planner/one_to_one_search.hpp"
@@ -114,11 +116,13 @@ class UpdateGenerator {
 }  // namespace
 
 void write_samples_csv(std::ostream& out, const std::vector<ReplanSample>& samples) {
-  out << "trip,step,dstar_ms,astar_ms,dijkstra_ms,dstar_expanded,dstar_raised,astar_settled,route_edges_before,reachable,dstar_path_checks\n";
+  out << "trip,step,dstar_ms,astar_ms,dijkstra_ms,dstar_expanded,dstar_raised,astar_settled,route_edges_before,reachable,"
+         "dstar_path_checks,cch_customization_ms,cch_repair_ms,cch_expanded,cch_changed_arcs\n";
   for (const ReplanSample& r : samples) {
     out << r.trip << ',' << r.step << ',' << r.dstar_ms << ',' << r.astar_ms << ',' << r.dijkstra_ms << ','
         << r.dstar_expanded << ',' << r.dstar_raised << ',' << r.astar_settled << ',' << r.route_edges_before << ','
-        << (r.reachable ? 1 : 0) << ',' << r.dstar_path_checks << '\n';
+        << (r.reachable ? 1 : 0) << ',' << r.dstar_path_checks << ',' << r.cch_customization_ms << ','
+        << r.cch_repair_ms << ',' << r.cch_expanded << ',' << r.cch_changed_arcs << '\n';
   }
 }
 
@@ -166,6 +170,13 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
   double expanded = 0, rekeyed = 0, raised = 0, path_checks = 0, astar_settled = 0, dijkstra_settled = 0;
   planner::OneToOneSearch astar, dijkstra;
   std::uniform_int_distribution<std::uint32_t> any_edge(0, static_cast<std::uint32_t>(graph.edge_count() - 1));
+  auto t_pre = Clock::now();
+  const planner::CchTopology topology(graph.turns());
+  res.cch_preprocessing_s = ms_since(t_pre) / 1000.0;
+  res.cch_arcs = topology.arc_count();
+  std::vector<double> t_cch_full, t_cch, t_cch_custom, t_cch_repair, t_cch0, cch_bytes;
+  double cch_changed = 0, cch_expanded = 0, cch_vertices = 0;
+  std::vector<std::uint32_t> changed_arcs;
   maps::ProgressBar progress("bench replan", config.trips);
 
   for (std::uint32_t trip = 0; trip < config.trips; ++trip) {
@@ -193,6 +204,14 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
     (void)astar.run(planner::SearchSpace(cost, {start}, {goal}), true);
     t_astar0.push_back(ms_since(t0));
     ++res.trips;
+    t0 = Clock::now();
+    planner::CchMetric metric(topology, cost);
+    t_cch_full.push_back(ms_since(t0));
+    t0 = Clock::now();
+    planner::CchDStarLite cch_dstar(metric, {start}, {goal});
+    cch_dstar.replan();
+    (void)cch_dstar.route();
+    t_cch0.push_back(ms_since(t0));
 
     std::unordered_set<std::uint32_t> changed_set;
     for (std::uint32_t step = 0; step < config.max_replans_per_trip && route.found; ++step) {
@@ -217,6 +236,24 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
       raised += static_cast<double>(stats.underconsistent);
       path_checks += static_cast<double>(stats.path_checks);
 
+      t0 = Clock::now();
+      changed_arcs.clear();
+      (void)metric.edges_changed(changed, changed_arcs);
+      const double custom_ms = ms_since(t0);
+      t0 = Clock::now();
+      cch_dstar.move_start({*position});
+      cch_dstar.edges_changed(changed);
+      cch_dstar.arcs_changed(changed_arcs);
+      const auto cch_stats = cch_dstar.replan();
+      const planner::Route cch_route = cch_dstar.route();
+      const double repair_ms = ms_since(t0);
+      t_cch_custom.push_back(custom_ms);
+      t_cch_repair.push_back(repair_ms);
+      t_cch.push_back(custom_ms + repair_ms);
+      cch_changed += static_cast<double>(changed_arcs.size());
+      cch_expanded += static_cast<double>(cch_stats.expanded);
+      cch_vertices += static_cast<double>(cch_dstar.space().upward_size() + cch_dstar.space().downward_size());
+
       const planner::SearchSpace space(cost, {*position}, {goal});
       planner::SearchStats s_astar, s_dijkstra;
       t0 = Clock::now();
@@ -235,17 +272,24 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
                        dstar.cost_to_goal_s(), d.travel_time_s);
         }
         if (costs_differ(a.travel_time_s, d.travel_time_s)) ++res.astar_mismatches;
+        if (costs_differ(cch_dstar.cost_to_goal_s(), d.travel_time_s) || costs_differ(cch_route.travel_time_s, d.travel_time_s)) {
+          ++res.cch_mismatches;
+          spdlog::warn("event=cch_mismatch trip={} step={} cch_s={:.9f} route_s={:.9f} dijkstra_s={:.9f}", trip, step,
+                       cch_dstar.cost_to_goal_s(), cch_route.travel_time_s, d.travel_time_s);
+        }
       }
       ++res.replans;
       res.samples.push_back({trip, step, t_dstar.back(), t_astar.back(), config.run_dijkstra ? t_dijkstra.back() : 0.0,
                              stats.expanded, stats.underconsistent, s_astar.settled, stats.path_checks,
-                             route.edges.size(), next.found});
+                             route.edges.size(), next.found, custom_ms, repair_ms, cch_stats.expanded,
+                             changed_arcs.size()});
       // Unchanged means: the new route is the rest of the old one from the vehicle's edge on.
       const auto from = std::find(route.edges.begin(), route.edges.end(), next.edges.empty() ? kInvalidEdge : next.edges.front());
       if (!std::equal(from, route.edges.end(), next.edges.begin(), next.edges.end())) ++res.route_changes;
       route = std::move(next);
     }
     planner_bytes.push_back(static_cast<double>(dstar.memory_bytes()));
+    cch_bytes.push_back(static_cast<double>(cch_dstar.memory_bytes()));
     progress.update(trip + 1);
   }
   progress.finish();
@@ -266,6 +310,17 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
   res.dstar_mean_path_checks = path_checks / n;
   res.astar_mean_settled = astar_settled / n;
   res.dijkstra_mean_settled = dijkstra_settled / n;
+  res.cch_customization_full = summarize_ms(t_cch_full);
+  res.cch_dstar = summarize_ms(t_cch);
+  res.cch_customization = summarize_ms(t_cch_custom);
+  res.cch_repair = summarize_ms(t_cch_repair);
+  res.cch_dstar_initial = summarize_ms(t_cch0);
+  res.cch_mean_changed_arcs = cch_changed / n;
+  res.cch_mean_expanded = cch_expanded / n;
+  res.cch_mean_vertices = cch_vertices / n;
+  res.cch_bytes_per_planner =
+      cch_bytes.empty() ? 0.0 : std::accumulate(cch_bytes.begin(), cch_bytes.end(), 0.0) / static_cast<double>(cch_bytes.size());
+  res.cch_max_bytes_per_planner = cch_bytes.empty() ? 0.0 : *std::max_element(cch_bytes.begin(), cch_bytes.end());
   return res;
 }
 
@@ -323,6 +378,19 @@ nlohmann::json to_json(const ReplanBenchResult& r, const ReplanBenchConfig& c) {
   j["speedup_p50_vs_dijkstra"] = c.run_dijkstra ? ratio(r.dijkstra.p50_ms, r.dstar.p50_ms) : 0.0;
   j["mismatches"] = r.mismatches;
   j["astar_mismatches"] = r.astar_mismatches;
+  j["dstar_cch"] = to_json(r.cch_dstar);
+  j["dstar_cch"]["customization"] = to_json(r.cch_customization);
+  j["dstar_cch"]["repair"] = to_json(r.cch_repair);
+  j["dstar_cch"]["initial_plan"] = to_json(r.cch_dstar_initial);
+  j["dstar_cch"]["full_customization"] = to_json(r.cch_customization_full);
+  j["dstar_cch"]["preprocessing_s"] = r.cch_preprocessing_s;
+  j["dstar_cch"]["arcs"] = r.cch_arcs;
+  j["dstar_cch"]["mean_changed_arcs"] = r.cch_mean_changed_arcs;
+  j["dstar_cch"]["mean_expanded"] = r.cch_mean_expanded;
+  j["dstar_cch"]["mean_vertices"] = r.cch_mean_vertices;
+  j["dstar_cch"]["mean_bytes_per_planner"] = r.cch_bytes_per_planner;
+  j["dstar_cch"]["max_bytes_per_planner"] = r.cch_max_bytes_per_planner;
+  j["dstar_cch"]["mismatches"] = r.cch_mismatches;
   return j;
 }
 

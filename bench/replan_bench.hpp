@@ -56,6 +56,10 @@ struct ReplanSample {
   std::uint64_t dstar_path_checks = 0;
   std::size_t route_edges_before = 0;
   bool reachable = true;
+  double cch_customization_ms = 0;
+  double cch_repair_ms = 0;
+  std::uint64_t cch_expanded = 0;
+  std::uint64_t cch_changed_arcs = 0;
 };
 
 struct ReplanBenchResult {
@@ -77,11 +81,23 @@ struct ReplanBenchResult {
   double dstar_mean_path_checks = 0;  // lazy raises: path walks per replan
   double astar_mean_settled = 0;
   double dijkstra_mean_settled = 0;
+  // D* Lite on the contraction hierarchy (CchDStarLite): a replan is the metric's partial
+  // customization for the batch, then the mission's repair.
+  double cch_preprocessing_s = 0;      // nested-dissection order and contraction, once per map
+  std::size_t cch_arcs = 0;
+  LatencySummary cch_customization_full;  // once per trip (a fresh overlay)
+  LatencySummary cch_dstar, cch_customization, cch_repair, cch_dstar_initial;
+  double cch_mean_changed_arcs = 0;      // arcs whose weight a batch moved
+  double cch_mean_expanded = 0;
+  double cch_mean_vertices = 0;          // upward + downward half
+  double cch_bytes_per_planner = 0;
+  double cch_max_bytes_per_planner = 0;
+  std::size_t cch_mismatches = 0;
   std::vector<ReplanSample> samples;
 };
 
 // trip,step,dstar_ms,astar_ms,dijkstra_ms,dstar_expanded,dstar_raised,astar_settled,route_edges_before,reachable,
-// dstar_path_checks
+// dstar_path_checks,cch_customization_ms,cch_repair_ms,cch_expanded,cch_changed_arcs
 void write_samples_csv(std::ostream& out, const std::vector<ReplanSample>& samples);
 
 // Throws std::invalid_argument for a config that cannot run (no trips, negative fractions, ...).

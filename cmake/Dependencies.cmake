@@ -24,6 +24,13 @@ add_library(corridor_geographiclib INTERFACE)
 target_link_libraries(corridor_geographiclib INTERFACE ${GEOGRAPHICLIB_LIBRARY})
 target_include_directories(corridor_geographiclib SYSTEM INTERFACE ${GEOGRAPHICLIB_INCLUDE_DIR})
 
+# METIS (nested-dissection order for the contraction hierarchy): no CMake config in Debian either.
+find_library(METIS_LIBRARY NAMES metis REQUIRED)
+find_path(METIS_INCLUDE_DIR metis.h REQUIRED)
+add_library(corridor_metis INTERFACE)
+target_link_libraries(corridor_metis INTERFACE ${METIS_LIBRARY})
+target_include_directories(corridor_metis SYSTEM INTERFACE ${METIS_INCLUDE_DIR})
+
 # libosmium is header-only; it needs protozero (PBF) and the compression/XML libraries.
 find_path(OSMIUM_INCLUDE_DIR osmium/osm.hpp REQUIRED)
 find_path(PROTOZERO_INCLUDE_DIR protozero/pbf_reader.hpp REQUIRED)

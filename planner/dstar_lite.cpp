@@ -5,9 +5,10 @@
 
 namespace corridor::planner {
 
-DStarLite::DStarLite(const TravelCost& cost, std::vector<EdgePoint> starts, std::vector<EdgePoint> goals,
-                     DStarLiteOptions options)
-    : space_(cost, std::move(starts), std::move(goals)),
+template <class Space>
+BasicDStarLite<Space>::BasicDStarLite(const typename Space::Source& source, std::vector<EdgePoint> starts,
+                                      std::vector<EdgePoint> goals, DStarLiteOptions options)
+    : space_(source, std::move(starts), std::move(goals)),
       options_(options),
       states_(std::make_unique<PagedVertexStates>(space_.vertex_count())),
       open_(PagedVertexStates::HeapPositions(states_.get())) {
@@ -17,19 +18,22 @@ DStarLite::DStarLite(const TravelCost& cost, std::vector<EdgePoint> starts, std:
   open_.push_or_update(goal.v, calculate_key(goal));
 }
 
-DStarLite::Key DStarLite::calculate_key(Vertex s) const {
+template <class Space>
+typename BasicDStarLite<Space>::Key BasicDStarLite<Space>::calculate_key(Vertex s) const {
   const VertexState& st = states_->get(s.v);
   const double m = std::min(st.g, st.rhs);
   return {add_cost(add_cost(m, space_.h_from_start_s(s)), km_), m};
 }
 
-double DStarLite::min_successor_cost(Vertex u) const {
+template <class Space>
+double BasicDStarLite<Space>::min_successor_cost(Vertex u) const {
   double best = kInfCost;
-  space_.for_each_successor(u, [&](Vertex v, double c, EdgeId) { best = std::min(best, add_cost(c, g(v))); });
+  space_.for_each_successor(u, [&](Vertex v, double c, const Via&) { best = std::min(best, add_cost(c, g(v))); });
   return best;
 }
 
-void DStarLite::update_vertex(Vertex u, bool activate) {
+template <class Space>
+void BasicDStarLite<Space>::update_vertex(Vertex u, bool activate) {
   const double gu = g(u);
   const double ru = rhs(u);
   if (gu == ru) {
@@ -40,7 +44,8 @@ void DStarLite::update_vertex(Vertex u, bool activate) {
   }
 }
 
-void DStarLite::recompute_rhs(Vertex u) {
+template <class Space>
+void BasicDStarLite<Space>::recompute_rhs(Vertex u) {
   if (u == space_.goal()) return;
   const double best = min_successor_cost(u);
   // An untouched vertex whose rhs stays infinite keeps its page unallocated.
@@ -48,15 +53,17 @@ void DStarLite::recompute_rhs(Vertex u) {
   update_vertex(u);
 }
 
-void DStarLite::move_start(std::vector<EdgePoint> starts) {
-  old_heads_.assign(space_.start_heads().begin(), space_.start_heads().end());
-  space_.set_starts(std::move(starts));
+template <class Space>
+void BasicDStarLite<Space>::move_start(std::vector<EdgePoint> starts) {
   // km grows by h(s_last, s_start) so that keys already queued stay lower bounds (paper line 38'').
-  km_ = add_cost(km_, space_.start_shift_s(old_heads_));
+  km_ = add_cost(km_, space_.move_starts(std::move(starts)));
+  // On a CCH the move also adds and removes arcs of the upward half.
+  for (Vertex v : space_.rewired()) recompute_rhs(v);
   recompute_rhs(space_.start());
 }
 
-void DStarLite::edges_changed(std::span<const EdgeId> edges) {
+template <class Space>
+void BasicDStarLite<Space>::edges_changed(std::span<const EdgeId> edges) {
   bool start_affected = false;
   for (EdgeId e : edges) {
     // Every arc whose cost can depend on e drives onto e (a turn onto e or one of its copies, or a
@@ -67,13 +74,22 @@ void DStarLite::edges_changed(std::span<const EdgeId> edges) {
   if (start_affected) recompute_rhs(space_.start());
 }
 
-void DStarLite::nodes_changed(std::span<const NodeId> nodes) {
+template <class Space>
+void BasicDStarLite<Space>::arcs_changed(std::span<const std::uint32_t> arcs)
+  requires std::is_same_v<Space, CchSearchSpace>
+{
+  for (std::uint32_t arc : arcs) space_.for_each_vertex_on_arc(arc, [&](Vertex u) { recompute_rhs(u); });
+}
+
+template <class Space>
+void BasicDStarLite<Space>::nodes_changed(std::span<const NodeId> nodes) {
   // A node's crossing delay is part of every arc that turns at it: the arcs out of the vertices
   // standing there, and of no other arc.
   for (NodeId n : nodes) space_.for_each_vertex_at(n, [&](Vertex u) { recompute_rhs(u); });
 }
 
-ReplanStats DStarLite::replan() {
+template <class Space>
+ReplanStats BasicDStarLite<Space>::replan() {
   ReplanStats stats;
   // A start whose every arc is closed reaches nothing, and a goal whose every arc is closed is
   // reached from nowhere, whatever the g values. The loop would settle the whole old search tree to
@@ -81,7 +97,7 @@ ReplanStats DStarLite::replan() {
   // replan carries on from a state that is still D* Lite's.
   const Vertex start = space_.start();
   bool start_cut_off = true;
-  space_.for_each_successor(start, [&](Vertex, double c, EdgeId) { start_cut_off = start_cut_off && c >= kInfCost; });
+  space_.for_each_successor(start, [&](Vertex, double c, const Via&) { start_cut_off = start_cut_off && c >= kInfCost; });
   bool goal_cut_off = true;
   space_.for_each_predecessor(space_.goal(), [&](Vertex, double c) { goal_cut_off = goal_cut_off && c >= kInfCost; });
   cut_off_ = start_cut_off || goal_cut_off;
@@ -96,7 +112,8 @@ ReplanStats DStarLite::replan() {
   return stats;
 }
 
-void DStarLite::compute_shortest_path(ReplanStats& stats) {
+template <class Space>
+void BasicDStarLite<Space>::compute_shortest_path(ReplanStats& stats) {
   const Vertex start = space_.start();
   const Vertex goal = space_.goal();
   // The paper stops once TopKey >= key(start). Here S's arcs can cost 0 (the vehicle exactly at a
@@ -154,7 +171,8 @@ void DStarLite::compute_shortest_path(ReplanStats& stats) {
   }
 }
 
-bool DStarLite::activate_stale_on_path(ReplanStats& stats) {
+template <class Space>
+bool BasicDStarLite<Space>::activate_stale_on_path(ReplanStats& stats) {
   ++stats.path_checks;
   const Vertex start = space_.start();
   const Vertex goal = space_.goal();
@@ -170,7 +188,7 @@ bool DStarLite::activate_stale_on_path(ReplanStats& stats) {
   for (std::size_t steps = 0; u != goal && steps < space_.vertex_count(); ++steps) {
     double best = kInfCost;
     Vertex next;
-    space_.for_each_successor(u, [&](Vertex v, double c, EdgeId) {
+    space_.for_each_successor(u, [&](Vertex v, double c, const Via&) {
       const double total = add_cost(c, v == goal ? 0.0 : g(v));
       if (total < best) {
         best = total;
@@ -192,7 +210,8 @@ bool DStarLite::activate_stale_on_path(ReplanStats& stats) {
   return false;
 }
 
-std::string DStarLite::invariant_violation() const {
+template <class Space>
+std::string BasicDStarLite<Space>::invariant_violation() const {
   for (std::uint32_t i = 0; i < space_.vertex_count(); ++i) {
     const Vertex u{i};
     const double expected_rhs = u == space_.goal() ? 0.0 : min_successor_cost(u);
@@ -212,23 +231,24 @@ std::string DStarLite::invariant_violation() const {
   return {};
 }
 
-std::size_t DStarLite::memory_bytes() const {
-  return sizeof(*this) + states_->bytes() + open_.capacity_bytes() +
-         (space_.starts().size() + space_.goals().size()) * sizeof(EdgePoint);
+template <class Space>
+std::size_t BasicDStarLite<Space>::memory_bytes() const {
+  return sizeof(*this) + states_->bytes() + open_.capacity_bytes() + space_.heap_bytes();
 }
 
-Route DStarLite::route() const {
+template <class Space>
+Route BasicDStarLite<Space>::route() const {
   const Vertex start = space_.start();
   const Vertex goal = space_.goal();
-  if (cost_to_goal_s() >= kInfCost) return space_.route_along({});
-  std::vector<EdgeId> edges;
+  if (cost_to_goal_s() >= kInfCost) return space_.route_along(std::vector<Via>{});
+  std::vector<Via> vias;
   Vertex u = start;
   // Every arc costs more than zero except S arcs, so a path has at most vertex_count arcs.
   for (std::size_t steps = 0; u != goal && steps < space_.vertex_count(); ++steps) {
     double best = kInfCost;
     Vertex next;
-    EdgeId via;
-    space_.for_each_successor(u, [&](Vertex v, double c, EdgeId e) {
+    Via via{};
+    space_.for_each_successor(u, [&](Vertex v, double c, const Via& e) {
       const double total = add_cost(c, v == goal ? 0.0 : g(v));
       if (total < best) {
         best = total;
@@ -236,11 +256,14 @@ Route DStarLite::route() const {
         via = e;
       }
     });
-    if (!next.valid()) return space_.route_along({});
-    edges.push_back(via);
+    if (!next.valid()) return space_.route_along(std::vector<Via>{});
+    vias.push_back(via);
     u = next;
   }
-  return space_.route_along(u == goal ? std::move(edges) : std::vector<EdgeId>{});
+  return space_.route_along(u == goal ? std::move(vias) : std::vector<Via>{});
 }
+
+template class BasicDStarLite<SearchSpace>;
+template class BasicDStarLite<CchSearchSpace>;
 
 }  // namespace corridor::planner

@@ -1,5 +1,8 @@
 // D* Lite (Koenig & Likhachev 2002, optimized version with key modifier km): one vehicle's route,
 // searched backward from the goal and repaired incrementally as costs change and the vehicle moves.
+// One algorithm over two graphs: the turn graph itself (DStarLite, on SearchSpace), and one
+// mission's slice of a customizable contraction hierarchy (CchDStarLite, on CchSearchSpace), where
+// a metro-scale repair touches a few thousand vertices instead of a city.
 // Optionally, raises (cost increases) are repaired lazily, as in Delayed D* (Ferguson & Stentz
 // 2005): only where they reach the vehicle's current path. Measured slower at metro scale (see
 // docs/routing.md), so off by default.
@@ -9,8 +12,10 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <type_traits>
 #include <vector>
 
+#include "planner/cch_search_space.hpp"
 #include "planner/indexed_heap.hpp"
 #include "planner/one_to_one_search.hpp"
 #include "planner/paged_vertex_state.hpp"
@@ -38,17 +43,26 @@ struct DStarLiteOptions {
   bool lazy_raises = false;
 };
 
-class DStarLite {
+// Space: SearchSpace (Source = TravelCost) or CchSearchSpace (Source = CchMetric).
+template <class Space>
+class BasicDStarLite {
  public:
-  // `cost` must outlive the planner. The caller changes the CostOverlay behind it and then reports
-  // the changed ids through edges_changed / nodes_changed before the next replan().
-  DStarLite(const TravelCost& cost, std::vector<EdgePoint> starts, std::vector<EdgePoint> goals,
-            DStarLiteOptions options = {});
+  using Via = typename Space::Via;
+
+  // `source` must outlive the planner. The caller changes the CostOverlay behind it and then reports
+  // the changed ids through edges_changed / nodes_changed before the next replan(). On a CCH, the
+  // caller first customizes the metric with the same changes and also reports the arcs it changed
+  // through arcs_changed.
+  BasicDStarLite(const typename Space::Source& source, std::vector<EdgePoint> starts, std::vector<EdgePoint> goals,
+                 DStarLiteOptions options = {});
 
   // The vehicle has moved. Cheap: the repair happens in replan().
   void move_start(std::vector<EdgePoint> starts);
   void edges_changed(std::span<const EdgeId> edges);
   void nodes_changed(std::span<const NodeId> nodes);
+  // The metric's customization changed these CCH arcs' weights.
+  void arcs_changed(std::span<const std::uint32_t> arcs)
+    requires std::is_same_v<Space, CchSearchSpace>;
 
   // ComputeShortestPath: brings the plan up to date with all reported changes.
   ReplanStats replan();
@@ -59,7 +73,7 @@ class DStarLite {
   // The current route, extracted greedily from the g values; valid after replan().
   [[nodiscard]] Route route() const;
 
-  [[nodiscard]] const SearchSpace& space() const { return space_; }
+  [[nodiscard]] const Space& space() const { return space_; }
   // What this planner holds: its vertex pages, open list and start points. It grows with the part
   // of the graph the searches touched, not with the graph.
   [[nodiscard]] std::size_t memory_bytes() const;
@@ -91,13 +105,17 @@ class DStarLite {
   [[nodiscard]] double g(Vertex v) const { return states_->get(v.v).g; }
   [[nodiscard]] double rhs(Vertex v) const { return states_->get(v.v).rhs; }
 
-  SearchSpace space_;
+  Space space_;
   DStarLiteOptions options_;
   std::unique_ptr<PagedVertexStates> states_;  // on the heap: the open list points into it
   IndexedHeap<Key, PagedVertexStates::HeapPositions> open_;
   double km_ = 0.0;
-  std::vector<NodeId> old_heads_;  // move_start's scratch: the heads before the move
   bool cut_off_ = false;  // every arc out of S or into G is closed: no route, repair deferred
 };
+
+extern template class BasicDStarLite<SearchSpace>;
+extern template class BasicDStarLite<CchSearchSpace>;
+using DStarLite = BasicDStarLite<SearchSpace>;
+using CchDStarLite = BasicDStarLite<CchSearchSpace>;
 
 }  // namespace corridor::planner

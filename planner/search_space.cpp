@@ -26,6 +26,12 @@ void SearchSpace::set_starts(std::vector<EdgePoint> starts) {
   start_heads_.erase(std::unique(start_heads_.begin(), start_heads_.end()), start_heads_.end());
 }
 
+double SearchSpace::move_starts(std::vector<EdgePoint> starts) {
+  old_heads_.assign(start_heads_.begin(), start_heads_.end());
+  set_starts(std::move(starts));
+  return start_shift_s(old_heads_);
+}
+
 double SearchSpace::start_shift_s(std::span<const NodeId> old_heads) const {
   double shift = 0.0;
   for (NodeId b : start_heads_) {

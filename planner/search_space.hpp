@@ -21,6 +21,9 @@ using Vertex = StrongId<struct VertexTag, std::uint32_t, std::numeric_limits<std
 
 class SearchSpace {
  public:
+  using Via = EdgeId;  // the road edge an arc drives on
+  using Source = TravelCost;
+
   // Starts and goals are alternative points (for example both directions of a two-way street).
   // Throws std::invalid_argument for an empty list, an unknown edge, or a non-finite offset.
   SearchSpace(const TravelCost& cost, std::vector<EdgePoint> starts, std::vector<EdgePoint> goals);
@@ -55,6 +58,16 @@ class SearchSpace {
   [[nodiscard]] std::span<const EdgePoint> starts() const { return starts_; }
   [[nodiscard]] std::span<const EdgePoint> goals() const { return goals_; }
   void set_starts(std::vector<EdgePoint> starts);
+  // The vehicle moved (D* Lite): set_starts, and how far the heuristic can fall anywhere with it,
+  // which D* Lite adds to its key modifier (start_shift_s from the old heads).
+  double move_starts(std::vector<EdgePoint> starts);
+  // The vertices whose arcs a move adds or removes, beyond S's own: none on the turn graph.
+  [[nodiscard]] std::span<const Vertex> rewired() const { return {}; }
+  // What the starts, goals and their nodes hold on the heap.
+  [[nodiscard]] std::size_t heap_bytes() const {
+    return (starts_.capacity() + goals_.capacity()) * sizeof(EdgePoint) +
+           (start_heads_.capacity() + goal_tails_.capacity() + old_heads_.capacity()) * sizeof(NodeId);
+  }
 
   // The road nodes S's arcs lead to and G's arcs come from (sorted).
   [[nodiscard]] std::span<const NodeId> start_heads() const { return start_heads_; }
@@ -170,6 +183,7 @@ class SearchSpace {
   std::vector<EdgePoint> goals_;
   std::vector<NodeId> start_heads_;
   std::vector<NodeId> goal_tails_;
+  std::vector<NodeId> old_heads_;  // move_starts' scratch: the heads before the move
 };
 
 }  // namespace corridor::planner

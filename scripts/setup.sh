@@ -8,7 +8,7 @@ packages=(
   libboost-dev libosmium2-dev libprotozero-dev zlib1g-dev libbz2-dev libexpat1-dev liblz4-dev
   libgeographiclib-dev libcli11-dev libspdlog-dev libfmt-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libopencv-dev libeigen3-dev libceres-dev
+  libopencv-dev libeigen3-dev libceres-dev libmetis-dev
   osmium-tool sumo sumo-tools python3 curl parallel
   chromium
 )

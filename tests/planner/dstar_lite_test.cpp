@@ -2,8 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <optional>
 #include <random>
+#include <tuple>
 
+#include "planner/cch_metric.hpp"
+#include "planner/cch_topology.hpp"
 #include "planner/one_to_one_search.hpp"
 #include "maps/osm_import.hpp"
 #include "maps/synthetic_grid.hpp"
@@ -26,7 +30,8 @@ void expect_same_cost(double expected, double actual, const std::string& where) 
 }
 
 // Checks D* Lite's cost, and the cost of the route it extracts, against Dijkstra from scratch.
-void expect_matches_dijkstra(const DStarLite& dstar, const TravelCost& cost, const std::vector<EdgePoint>& starts,
+template <class Planner>
+void expect_matches_dijkstra(const Planner& dstar, const TravelCost& cost, const std::vector<EdgePoint>& starts,
                              const std::vector<EdgePoint>& goals, const std::string& where) {
   OneToOneSearch dijkstra;
   const Route oracle = dijkstra.run(SearchSpace(cost, starts, goals), false);
@@ -51,6 +56,8 @@ TEST(DStarLite, InitialPlanMatchesDijkstraOnRandomGraphs) {
     CostOverlay overlay(g);
     overlay.set_signal_delay(g, 7.5);
     const TravelCost cost(g, overlay, testing::oracle_profile(seed, 30.0));
+    const CchTopology topology(g.turns());
+    const CchMetric metric(topology, cost);
     std::mt19937_64 rng(seed);
     for (int q = 0; q < 10; ++q) {
       const auto starts = with_twin(g, random_point(g, rng));
@@ -58,14 +65,62 @@ TEST(DStarLite, InitialPlanMatchesDijkstraOnRandomGraphs) {
       DStarLite dstar(cost, starts, goals);
       dstar.replan();
       expect_matches_dijkstra(dstar, cost, starts, goals, "seed " + std::to_string(seed));
+      CchDStarLite on_cch(metric, starts, goals);
+      on_cch.replan();
+      expect_matches_dijkstra(on_cch, cost, starts, goals, "CCH, seed " + std::to_string(seed));
     }
   }
 }
 
 // Thousands of random update sequences: cost increases and decreases on and off the route,
 // closures and reopenings, node and movement delay changes, and start moves, checked after every
-// replan.
-class DStarLiteRepair : public ::testing::TestWithParam<bool> {};
+// replan. On the turn graph (eager and lazy raises), and on a contraction hierarchy, whose metric
+// is customized with each batch and checked against its own invariants.
+enum class Variant { eager, lazy, cch };
+
+// One D* Lite of either kind, fed the same reports.
+class AnyDStarLite {
+ public:
+  AnyDStarLite(Variant v, const TravelCost& cost, std::vector<EdgePoint> starts, std::vector<EdgePoint> goals) {
+    if (v == Variant::cch) {
+      topology_.emplace(cost.graph().turns());
+      metric_.emplace(*topology_, cost);
+      cch_.emplace(*metric_, std::move(starts), std::move(goals));
+    } else {
+      flat_.emplace(cost, std::move(starts), std::move(goals), DStarLiteOptions{v == Variant::lazy});
+    }
+  }
+  void move_start(std::vector<EdgePoint> starts) { cch_ ? cch_->move_start(std::move(starts)) : flat_->move_start(std::move(starts)); }
+  void changed(const std::vector<EdgeId>& edges, const std::vector<NodeId>& nodes) {
+    if (!cch_) {
+      flat_->edges_changed(edges);
+      flat_->nodes_changed(nodes);
+      return;
+    }
+    std::vector<std::uint32_t> arcs;
+    metric_->edges_changed(edges, arcs);
+    metric_->nodes_changed(nodes, arcs);
+    cch_->edges_changed(edges);
+    cch_->nodes_changed(nodes);
+    cch_->arcs_changed(arcs);
+  }
+  ReplanStats replan() { return cch_ ? cch_->replan() : flat_->replan(); }
+  [[nodiscard]] Route route() const { return cch_ ? cch_->route() : flat_->route(); }
+  [[nodiscard]] double cost_to_goal_s() const { return cch_ ? cch_->cost_to_goal_s() : flat_->cost_to_goal_s(); }
+  [[nodiscard]] std::string invariant_violation() const {
+    if (!cch_) return flat_->invariant_violation();
+    const std::string metric = metric_->invariant_violation();
+    return metric.empty() ? cch_->invariant_violation() : "metric: " + metric;
+  }
+
+ private:
+  std::optional<DStarLite> flat_;
+  std::optional<CchTopology> topology_;
+  std::optional<CchMetric> metric_;
+  std::optional<CchDStarLite> cch_;
+};
+
+class DStarLiteRepair : public ::testing::TestWithParam<Variant> {};
 
 TEST_P(DStarLiteRepair, ReplanMatchesDijkstraAfterRandomUpdateSequences) {
   int replans = 0;
@@ -79,7 +134,7 @@ TEST_P(DStarLiteRepair, ReplanMatchesDijkstraAfterRandomUpdateSequences) {
     std::uniform_real_distribution<double> unit(0.0, 1.0);
     auto starts = with_twin(g, random_point(g, rng));
     const auto goals = std::vector<EdgePoint>{random_point(g, rng)};
-    DStarLite dstar(cost, starts, goals, DStarLiteOptions{GetParam()});
+    AnyDStarLite dstar(GetParam(), cost, starts, goals);
     dstar.replan();
     for (int step = 0; step < 25; ++step) {
       const Route current = dstar.route();
@@ -127,8 +182,7 @@ TEST_P(DStarLiteRepair, ReplanMatchesDijkstraAfterRandomUpdateSequences) {
         }
         dstar.move_start(starts);
       }
-      dstar.edges_changed(edges);
-      dstar.nodes_changed(nodes);
+      dstar.changed(edges, nodes);
       ASSERT_EQ(dstar.invariant_violation(), "") << "before replan, seed " << seed << " step " << step;
       dstar.replan();
       ASSERT_EQ(dstar.invariant_violation(), "") << "seed " << seed << " step " << step;
@@ -140,8 +194,10 @@ TEST_P(DStarLiteRepair, ReplanMatchesDijkstraAfterRandomUpdateSequences) {
   EXPECT_EQ(replans, kSequences * 25);
 }
 
-INSTANTIATE_TEST_SUITE_P(EagerAndLazyRaises, DStarLiteRepair, ::testing::Bool(),
-                         [](const ::testing::TestParamInfo<bool>& p) { return p.param ? "lazy" : "eager"; });
+INSTANTIATE_TEST_SUITE_P(EagerLazyAndCch, DStarLiteRepair, ::testing::Values(Variant::eager, Variant::lazy, Variant::cch),
+                         [](const ::testing::TestParamInfo<Variant>& p) {
+                           return p.param == Variant::lazy ? "lazy" : p.param == Variant::cch ? "cch" : "eager";
+                         });
 
 // A mission that touches a small part of a big graph holds a small part of its state: the per-vertex
 // records live in pages allocated on first write.
@@ -256,10 +312,11 @@ TEST(DStarLite, UnreachableGoalAndRecovery) {
 
 // The same randomized oracle on real maps: trips with congestion on and off the route, start moves
 // along the route, and checks after every replan.
-class DStarLiteOnExtract : public ::testing::TestWithParam<const char*> {};
+class DStarLiteOnExtract : public ::testing::TestWithParam<std::tuple<const char*, Variant>> {};
 
 TEST_P(DStarLiteOnExtract, ReplanMatchesDijkstraWhileDriving) {
-  const auto file = std::filesystem::path(CORRIDOR_SHARED_DATA_DIR) / "osm" / GetParam();
+  const char* map = std::get<0>(GetParam());
+  const auto file = std::filesystem::path(CORRIDOR_SHARED_DATA_DIR) / "osm" / map;
   if (!std::filesystem::exists(file)) GTEST_SKIP() << "shared data not present: " << file;
   maps::OsmImportOptions options;
   options.show_progress = false;
@@ -273,7 +330,7 @@ TEST_P(DStarLiteOnExtract, ReplanMatchesDijkstraWhileDriving) {
     const TravelCost cost(g, overlay, {120.0 / 3.6});
     const std::vector<EdgePoint> goals = with_twin(g, random_point(g, rng));
     std::vector<EdgePoint> starts = with_twin(g, random_point(g, rng));
-    DStarLite dstar(cost, starts, goals);
+    AnyDStarLite dstar(std::get<1>(GetParam()), cost, starts, goals);
     dstar.replan();
     for (int step = 0; step < 20; ++step) {
       Route r = dstar.route();
@@ -291,9 +348,9 @@ TEST_P(DStarLiteOnExtract, ReplanMatchesDijkstraWhileDriving) {
       }
       starts = {{r.edges[1], g.length_m(r.edges[1]) * unit(rng)}};
       dstar.move_start(starts);
-      dstar.edges_changed(changed);
+      dstar.changed(changed, {});
       dstar.replan();
-      expect_matches_dijkstra(dstar, cost, starts, goals, std::string(GetParam()) + " trip " + std::to_string(trip));
+      expect_matches_dijkstra(dstar, cost, starts, goals, std::string(map) + " trip " + std::to_string(trip));
       ++replans;
       if (::testing::Test::HasFailure()) return;
     }
@@ -302,7 +359,13 @@ TEST_P(DStarLiteOnExtract, ReplanMatchesDijkstraWhileDriving) {
 }
 
 INSTANTIATE_TEST_SUITE_P(RealMaps, DStarLiteOnExtract,
-                         ::testing::Values("monaco.osm.gz", "andorra.osm.pbf", "liechtenstein.osm.pbf"));
+                         ::testing::Combine(::testing::Values("monaco.osm.gz", "andorra.osm.pbf", "liechtenstein.osm.pbf"),
+                                            ::testing::Values(Variant::eager, Variant::cch)),
+                         [](const ::testing::TestParamInfo<std::tuple<const char*, Variant>>& p) {
+                           std::string name = std::get<0>(p.param);
+                           name = name.substr(0, name.find('.'));
+                           return name + (std::get<1>(p.param) == Variant::cch ? "_cch" : "");
+                         });
 
 }  // namespace
 }  // namespace corridor::planner

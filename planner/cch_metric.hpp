@@ -1,0 +1,94 @@
+// The metric half of a customizable contraction hierarchy: one weight per arc and direction of a
+// CchTopology, derived from a TravelCost (one vehicle profile over the live cost overlay), so that
+// every arc holds the cost of the cheapest path between its ends through lower ranks. Built by a
+// full customization; kept current by partial customization as congestion changes, which
+// re-derives only the arcs an input change can reach (Dibbelt, Strasser & Wagner 2016, §5). The
+// arcs whose weights moved are handed back, so the searches above can repair themselves.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "planner/cch_topology.hpp"
+#include "planner/travel_cost.hpp"
+
+namespace corridor::planner {
+
+struct CustomizationStats {
+  std::uint64_t recomputed = 0;  // arcs re-derived
+  std::uint64_t changed = 0;     // of those, arcs whose weight moved
+};
+
+class CchMetric {
+ public:
+  // Full customization. `topology` and `cost` must outlive the metric.
+  CchMetric(const CchTopology& topology, const TravelCost& cost);
+
+  // Weight of arc `arc` from its lower end to its higher end, and back; kInfCost for none.
+  [[nodiscard]] double up_s(std::uint32_t arc) const { return up_[arc]; }
+  [[nodiscard]] double down_s(std::uint32_t arc) const { return down_[arc]; }
+  [[nodiscard]] const CchTopology& topology() const { return *topology_; }
+  [[nodiscard]] const TravelCost& cost() const { return *cost_; }
+
+  // The cost overlay behind `cost` changed these edges' conditions or these nodes' delays:
+  // re-derive what they reach. Appends the ids of arcs whose weights changed to `changed`.
+  CustomizationStats edges_changed(std::span<const EdgeId> edges, std::vector<std::uint32_t>& changed);
+  CustomizationStats nodes_changed(std::span<const NodeId> nodes, std::vector<std::uint32_t>& changed);
+
+  // The cost of turn-graph arc `index` (an index into the turn graph's out-arcs): the turn plus
+  // driving the edge it turns onto, exactly as SearchSpace charges it.
+  [[nodiscard]] double input_s(std::uint32_t index) const;
+
+  // The turn-graph vertices (not ranks) of the cheapest path that arc `arc` stands for, from
+  // its lower end (`upward`) or its higher end, excluding the first vertex, appended to `out`.
+  void unpack(std::uint32_t arc, bool upward, std::vector<std::uint32_t>& out) const;
+
+  // Checks every arc against its lower triangles and its input; for tests. Empty when all hold.
+  [[nodiscard]] std::string invariant_violation() const;
+
+  [[nodiscard]] std::size_t memory_bytes() const;
+
+ private:
+  void customize_all();
+  // Settles queued arcs in rank order of their lower end. An arc that changed offers its new
+  // value through every triangle it is a lower side of: a cheaper path lowers the arc above at
+  // once; a rise where the old value was the arc's minimum queues it to be re-derived.
+  CustomizationStats propagate(std::vector<std::uint32_t>& changed);
+  // Queues `arc` (saving its weights as they were before this round), to be re-derived from its
+  // input and triangles when `derive`.
+  void queue(std::uint32_t arc, bool derive = true);
+  // Triangle {x, y, z} offers `arc` (one of its upper sides) new_s in place of old_s, in one
+  // direction.
+  void offer(std::uint32_t arc, bool upward, double old_s, double new_s, std::uint32_t via);
+  void queue_turns_into(std::uint32_t turn_vertex);
+  void queue_turns_out_of(std::uint32_t turn_vertex);
+  // The weights a lower-triangle scan and the input give arc `arc` now, with their witnesses.
+  struct Derived {
+    double up;
+    double down;
+    std::uint32_t via_up;
+    std::uint32_t via_down;
+  };
+  [[nodiscard]] Derived derive(std::uint32_t arc) const;
+
+  const CchTopology* topology_;
+  const TravelCost* cost_;
+  std::vector<double> up_;
+  std::vector<double> down_;
+  // Each weight's witness: the middle rank z of the lower triangle whose sum it is, or kNoCchArc
+  // where it is the input turn's cost. Unpacking a route follows them.
+  std::vector<std::uint32_t> via_up_;
+  std::vector<std::uint32_t> via_down_;
+  // One queued arc: its weights before this round, and whether it must be re-derived.
+  struct Pending {
+    double old_up;
+    double old_down;
+    bool derive;
+  };
+  std::vector<std::uint32_t> heap_;     // queued arcs, a min-heap by id (ids follow the lower end's rank)
+  std::vector<std::uint32_t> slot_;     // by arc: 1 + its index in pending_, or 0 when not queued
+  std::vector<Pending> pending_;
+};
+
+}  // namespace corridor::planner

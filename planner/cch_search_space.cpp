@@ -1,0 +1,107 @@
+#include "planner/cch_search_space.hpp"
+
+#include <iterator>
+
+namespace corridor::planner {
+
+CchSearchSpace::CchSearchSpace(const CchMetric& metric, std::vector<EdgePoint> starts, std::vector<EdgePoint> goals)
+    : metric_(&metric),
+      topology_(&metric.topology()),
+      n_(metric.topology().vertex_count()),
+      flat_(metric.cost(), std::move(starts), std::move(goals)) {
+  const maps::TurnGraph& turns = topology_->turns();
+  // G's arcs: every turn onto a goal edge, or onto one of its via-way copies, as SearchSpace has them.
+  for (std::uint32_t i = 0; i < flat_.goals().size(); ++i) {
+    const EdgeId e = flat_.goals()[i].edge;
+    auto turns_into = [&](std::uint32_t v) {
+      for (const maps::TurnArc& in : turns.arcs_in(v)) {
+        for (const maps::TurnArc& out : turns.arcs_out(in.other)) {
+          if (out.other != v) continue;
+          const auto index = static_cast<std::uint32_t>(&out - turns.arcs_out(0).data());
+          targets_.push_back({topology_->rank(in.other), i, index});
+        }
+      }
+    };
+    turns_into(e.v);
+    for (std::uint32_t c : turns.copies_of(e)) turns_into(c);
+  }
+  std::sort(targets_.begin(), targets_.end(), [](const Target& a, const Target& b) { return a.rank < b.rank; });
+  std::vector<std::uint32_t> from;
+  for (const Target& t : targets_) from.push_back(t.rank);
+  build_half(from, down_set_, down_first_, down_arcs_);
+  from.clear();
+  for (const EdgePoint& s : flat_.starts()) from.push_back(topology_->rank(s.vertex()));
+  build_half(from, up_set_, up_first_, up_arcs_);
+}
+
+void CchSearchSpace::build_half(std::span<const std::uint32_t> from, std::vector<std::uint32_t>& set,
+                                std::vector<std::uint32_t>& first, std::vector<CchDownArc>& arcs) const {
+  topology_->ancestors(from, set);
+  // Every higher neighbour of a member is a member (an ancestor of an ancestor).
+  first.assign(set.size() + 1, 0);
+  auto index_of = [&](std::uint32_t r) {
+    return static_cast<std::size_t>(std::lower_bound(set.begin(), set.end(), r) - set.begin());
+  };
+  for (std::uint32_t x : set) {
+    for (std::uint32_t y : topology_->up(x)) ++first[index_of(y) + 1];
+  }
+  for (std::size_t i = 1; i < first.size(); ++i) first[i] += first[i - 1];
+  arcs.resize(first.back());
+  std::vector<std::uint32_t> fill(first.begin(), first.end() - 1);
+  for (std::uint32_t x : set) {
+    const auto ups = topology_->up(x);
+    for (std::size_t i = 0; i < ups.size(); ++i) {
+      arcs[fill[index_of(ups[i])]++] = {x, topology_->first_up(x) + static_cast<std::uint32_t>(i)};
+    }
+  }
+}
+
+double CchSearchSpace::move_starts(std::vector<EdgePoint> starts) {
+  flat_.set_starts(std::move(starts));
+  std::vector<std::uint32_t> old_set;
+  old_set.swap(up_set_);
+  std::vector<std::uint32_t> from;
+  for (const EdgePoint& s : flat_.starts()) from.push_back(topology_->rank(s.vertex()));
+  build_half(from, up_set_, up_first_, up_arcs_);
+  // A vertex that joined or left the upward half gained or lost its upward arcs.
+  std::vector<std::uint32_t> moved;
+  std::set_symmetric_difference(old_set.begin(), old_set.end(), up_set_.begin(), up_set_.end(), std::back_inserter(moved));
+  rewired_.clear();
+  for (std::uint32_t r : moved) rewired_.push_back(Vertex{r});
+  return 0.0;
+}
+
+double CchSearchSpace::target_cost_s(const Target& t) const {
+  const maps::TurnGraph& turns = topology_->turns();
+  const EdgePoint& g = goals()[t.goal];
+  const maps::TurnArc& a = topology_->turn_arc(t.turn);
+  const double turn = cost().turn_cost_s(turns.edge_of(topology_->turn_arc_source(t.turn)), a, g.edge);
+  if (turn >= kInfCost) return kInfCost;
+  // As SearchSpace's goal arc: cross the goal edge's tail, then drive to the goal point.
+  const double arrive = add_cost(cost().node_delay_s(cost().graph().tail(g.edge)), cost().partial_time_s(g.edge, 0.0, g.offset_m));
+  return add_cost(turn, arrive);
+}
+
+Route CchSearchSpace::route_along(const std::vector<Via>& vias) const {
+  std::vector<EdgeId> edges;
+  std::vector<std::uint32_t> vertices;
+  for (const Via& via : vias) {
+    if (via.kind == Via::Kind::up || via.kind == Via::Kind::down) {
+      vertices.clear();
+      metric_->unpack(via.arc, via.kind == Via::Kind::up, vertices);
+      for (std::uint32_t v : vertices) edges.push_back(topology_->turns().edge_of(v));
+    } else {
+      edges.push_back(via.edge);
+    }
+  }
+  return flat_.route_along(std::move(edges));
+}
+
+std::size_t CchSearchSpace::heap_bytes() const {
+  return flat_.heap_bytes() + (up_set_.capacity() + up_first_.capacity() + down_set_.capacity() + down_first_.capacity()) *
+                             sizeof(std::uint32_t) +
+         (up_arcs_.capacity() + down_arcs_.capacity()) * sizeof(CchDownArc) + targets_.capacity() * sizeof(Target) +
+         rewired_.capacity() * sizeof(Vertex);
+}
+
+}  // namespace corridor::planner

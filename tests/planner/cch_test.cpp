@@ -1,0 +1,141 @@
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "planner/cch_metric.hpp"
+#include "planner/cch_topology.hpp"
+#include "tests/planner/test_graphs.hpp"
+
+namespace corridor::planner {
+namespace {
+
+using testing::random_grid;
+
+// The contraction is a chordal supergraph of the turn graph: every turn has an arc, the higher
+// neighbours of a vertex are pairwise joined, and they all lie on its elimination-tree path.
+TEST(CchTopology, ContractionIsChordalAndHoldsEveryTurn) {
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    const auto grid = random_grid(seed, 8, 9);
+    const auto g = testing::with_random_restrictions(grid, seed, grid.edge_count() / 6);
+    const maps::TurnGraph& turns = g.turns();
+    const CchTopology t(turns);
+    ASSERT_EQ(t.vertex_count(), turns.vertex_count());
+    for (std::uint32_t v = 0; v < turns.vertex_count(); ++v) {
+      ASSERT_EQ(t.vertex_at(t.rank(v)), v);
+      for (const maps::TurnArc& a : turns.arcs_out(v)) {
+        if (a.other == v) continue;
+        const std::uint32_t arc = t.find_arc(t.rank(v), t.rank(a.other));
+        ASSERT_NE(arc, kNoCchArc) << "seed " << seed;
+        const auto& in = t.input(arc);
+        const std::uint32_t index = t.rank(v) < t.rank(a.other) ? in.up : in.down;
+        ASSERT_NE(index, kNoCchArc);
+        EXPECT_EQ(&t.turn_arc(index), &a);
+        EXPECT_EQ(t.turn_arc_source(index), v);
+      }
+    }
+    std::vector<std::uint32_t> path;
+    for (std::uint32_t r = 0; r < t.vertex_count(); ++r) {
+      const auto ups = t.up(r);
+      ASSERT_TRUE(std::is_sorted(ups.begin(), ups.end()));
+      for (std::size_t i = 0; i < ups.size(); ++i) {
+        ASSERT_GT(ups[i], r);
+        for (std::size_t j = i + 1; j < ups.size(); ++j) ASSERT_NE(t.find_arc(ups[i], ups[j]), kNoCchArc) << "seed " << seed;
+      }
+      const std::uint32_t one[] = {r};
+      t.ancestors(one, path);
+      for (std::uint32_t u : ups) EXPECT_TRUE(std::binary_search(path.begin(), path.end(), u)) << "seed " << seed;
+      for (const CchDownArc& d : t.down(r)) EXPECT_EQ(t.head(d.arc), r);
+    }
+  }
+}
+
+// Partial customization ends exactly where a full customization of the changed overlay does, arc
+// by arc, whatever mix of rises, falls, closures and node delays a batch brings.
+TEST(CchMetric, PartialCustomizationEqualsFullCustomization) {
+  int batches = 0;
+  for (std::uint64_t seed = 1; seed <= 40; ++seed) {
+    const auto grid = random_grid(seed, 7, 8);
+    const auto g = testing::with_random_restrictions(grid, seed, grid.edge_count() / 8);
+    CostOverlay overlay(g);
+    const TravelCost cost(g, overlay, testing::oracle_profile(seed, 25.0));
+    const CchTopology t(g.turns());
+    CchMetric metric(t, cost);
+    ASSERT_EQ(metric.invariant_violation(), "");
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    for (int batch = 0; batch < 30; ++batch) {
+      std::vector<EdgeId> edges;
+      std::vector<NodeId> nodes;
+      for (int k = 0; k < 5; ++k) {
+        const EdgeId e = testing::random_point(g, rng).edge;
+        const double r = unit(rng);
+        if (r < 0.1) {
+          overlay.close_edge(e);
+        } else if (r < 0.45) {
+          overlay.reset_edge(e);
+        } else {
+          overlay.set_edge(e, {1.0 + unit(rng) * 4.0, unit(rng) < 0.5 ? unit(rng) * 60.0 : 0.0});
+        }
+        edges.push_back(e);
+      }
+      if (unit(rng) < 0.3) {
+        const NodeId n{std::uniform_int_distribution<std::uint32_t>(0, static_cast<std::uint32_t>(g.node_count() - 1))(rng)};
+        overlay.set_node_delay(n, unit(rng) < 0.5 ? 0.0 : unit(rng) * 30.0);
+        nodes.push_back(n);
+      }
+      std::vector<std::uint32_t> changed, changed_by_nodes;
+      metric.edges_changed(edges, changed);
+      metric.nodes_changed(nodes, changed_by_nodes);
+      const CchMetric fresh(t, cost);
+      std::vector<std::uint32_t> differ;
+      for (std::uint32_t arc = 0; arc < t.arc_count(); ++arc) {
+        ASSERT_EQ(metric.up_s(arc), fresh.up_s(arc)) << "seed " << seed << " batch " << batch << " arc " << arc;
+        ASSERT_EQ(metric.down_s(arc), fresh.down_s(arc)) << "seed " << seed << " batch " << batch << " arc " << arc;
+      }
+      ASSERT_EQ(metric.invariant_violation(), "") << "seed " << seed << " batch " << batch;
+      // One call reports an arc at most once.
+      for (auto* list : {&changed, &changed_by_nodes}) {
+        std::sort(list->begin(), list->end());
+        EXPECT_EQ(std::adjacent_find(list->begin(), list->end()), list->end());
+      }
+      ++batches;
+    }
+  }
+  EXPECT_EQ(batches, 40 * 30);
+}
+
+// A shortcut unpacks into the turns it stands for, and they cost what it weighs.
+TEST(CchMetric, ShortcutsUnpackIntoTurnsOfTheirWeight) {
+  const auto g = random_grid(5, 9, 9);
+  CostOverlay overlay(g);
+  const TravelCost cost(g, overlay, testing::oracle_profile(5, 25.0));
+  const CchTopology t(g.turns());
+  const CchMetric metric(t, cost);
+  int shortcuts = 0;
+  std::vector<std::uint32_t> path;
+  for (std::uint32_t arc = 0; arc < t.arc_count(); ++arc) {
+    for (const bool upward : {true, false}) {
+      const double w = upward ? metric.up_s(arc) : metric.down_s(arc);
+      if (w >= kInfCost) continue;
+      path.clear();
+      metric.unpack(arc, upward, path);
+      std::uint32_t from = t.vertex_at(upward ? t.tail(arc) : t.head(arc));
+      const std::uint32_t to = t.vertex_at(upward ? t.head(arc) : t.tail(arc));
+      ASSERT_FALSE(path.empty());
+      EXPECT_EQ(path.back(), to);
+      double sum = 0.0;
+      for (std::uint32_t v : path) {
+        const auto [turn, vertex] = cost.turn_onto(from, g.turns().edge_of(v));
+        ASSERT_EQ(vertex, v);
+        sum = add_cost(sum, add_cost(turn, cost.transit_s(g.turns().edge_of(v))));
+        from = v;
+      }
+      EXPECT_NEAR(sum, w, 1e-9 * std::max(1.0, w));
+      if (path.size() > 1) ++shortcuts;
+    }
+  }
+  EXPECT_GT(shortcuts, 50);
+}
+
+}  // namespace
+}  // namespace corridor::planner
