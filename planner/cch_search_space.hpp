@@ -180,7 +180,7 @@ class CchSearchSpace {
   // Builds a half over the ancestors of `from`: its members, and the arcs between members filed
   // under their higher end (the upward half enters it by them, the downward half leaves by them).
   void build_half(std::span<const std::uint32_t> from, std::vector<std::uint32_t>& set, std::vector<std::uint32_t>& first,
-                  std::vector<CchDownArc>& arcs) const;
+                  std::vector<CchDownArc>& arcs);
 
   const CchMetric* metric_;
   const CchTopology* topology_;
@@ -192,6 +192,7 @@ class CchSearchSpace {
   std::vector<std::uint32_t> down_set_, down_first_;
   std::vector<CchDownArc> down_arcs_;
   std::vector<Vertex> rewired_;
+  std::vector<std::uint32_t> slots_, fill_;  // build_half's scratch
 };
 
 }  // namespace corridor::planner
