@@ -174,6 +174,7 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
   const planner::CchTopology topology(graph.turns());
   res.cch_preprocessing_s = ms_since(t_pre) / 1000.0;
   res.cch_arcs = topology.arc_count();
+  res.cch_topology_bytes = topology.memory_bytes();
   std::vector<double> t_cch_full, t_cch, t_cch_custom, t_cch_repair, t_cch0, cch_bytes;
   double cch_changed = 0, cch_expanded = 0, cch_vertices = 0;
   std::vector<std::uint32_t> changed_arcs;
@@ -207,8 +208,9 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
     t0 = Clock::now();
     planner::CchMetric metric(topology, cost);
     t_cch_full.push_back(ms_since(t0));
+    res.cch_metric_bytes = metric.memory_bytes();
     t0 = Clock::now();
-    planner::CchDStarLite cch_dstar(metric, {start}, {goal});
+    planner::CchDStarLite cch_dstar(metric, {start}, {goal}, planner::DStarLiteOptions{config.lazy_raises});
     cch_dstar.replan();
     (void)cch_dstar.route();
     t_cch0.push_back(ms_since(t0));
@@ -385,6 +387,9 @@ nlohmann::json to_json(const ReplanBenchResult& r, const ReplanBenchConfig& c) {
   j["dstar_cch"]["full_customization"] = to_json(r.cch_customization_full);
   j["dstar_cch"]["preprocessing_s"] = r.cch_preprocessing_s;
   j["dstar_cch"]["arcs"] = r.cch_arcs;
+  // Shared by every mission on the map (the metric: by every mission with the same cost model).
+  j["dstar_cch"]["topology_bytes"] = r.cch_topology_bytes;
+  j["dstar_cch"]["metric_bytes"] = r.cch_metric_bytes;
   j["dstar_cch"]["mean_changed_arcs"] = r.cch_mean_changed_arcs;
   j["dstar_cch"]["mean_expanded"] = r.cch_mean_expanded;
   j["dstar_cch"]["mean_vertices"] = r.cch_mean_vertices;

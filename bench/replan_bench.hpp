@@ -85,6 +85,8 @@ struct ReplanBenchResult {
   // customization for the batch, then the mission's repair.
   double cch_preprocessing_s = 0;      // nested-dissection order and contraction, once per map
   std::size_t cch_arcs = 0;
+  std::size_t cch_topology_bytes = 0;
+  std::size_t cch_metric_bytes = 0;
   LatencySummary cch_customization_full;  // once per trip (a fresh overlay)
   LatencySummary cch_dstar, cch_customization, cch_repair, cch_dstar_initial;
   double cch_mean_changed_arcs = 0;      // arcs whose weight a batch moved

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <functional>
+#include <stdexcept>
 #include <string>
 
 namespace corridor::planner {
@@ -14,6 +15,9 @@ CchMetric::CchMetric(const CchTopology& topology, const TravelCost& cost)
       via_up_(topology.arc_count(), kNoCchArc),
       via_down_(topology.arc_count(), kNoCchArc),
       slot_(topology.arc_count(), 0) {
+  if (&topology.turns() != &cost.graph().turns()) {
+    throw std::invalid_argument("the contraction hierarchy was built for another graph than the cost model's");
+  }
   customize_all();
 }
 

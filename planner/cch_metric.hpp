@@ -22,7 +22,8 @@ struct CustomizationStats {
 
 class CchMetric {
  public:
-  // Full customization. `topology` and `cost` must outlive the metric.
+  // Full customization. `topology` and `cost` must outlive the metric; std::invalid_argument when
+  // the topology was built over another graph than the cost's.
   CchMetric(const CchTopology& topology, const TravelCost& cost);
 
   // Weight of arc `arc` from its lower end to its higher end, and back; kInfCost for none.

@@ -26,20 +26,22 @@ CchSearchSpace::CchSearchSpace(const CchMetric& metric, std::vector<EdgePoint> s
     for (std::uint32_t c : turns.copies_of(e)) turns_into(c);
   }
   std::sort(targets_.begin(), targets_.end(), [](const Target& a, const Target& b) { return a.rank < b.rank; });
-  std::vector<std::uint32_t> from;
+  std::vector<std::uint32_t> from, members;
   for (const Target& t : targets_) from.push_back(t.rank);
-  build_half(from, down_set_, down_first_, down_arcs_);
+  topology_->ancestors(from, members);
+  build_half(std::move(members), down_set_, down_first_, down_arcs_);
   from.clear();
   for (const EdgePoint& s : flat_.starts()) from.push_back(topology_->rank(s.vertex()));
-  build_half(from, up_set_, up_first_, up_arcs_);
+  topology_->ancestors(from, members);
+  build_half(std::move(members), up_set_, up_first_, up_arcs_);
 }
 
-void CchSearchSpace::build_half(std::span<const std::uint32_t> from, std::vector<std::uint32_t>& set,
-                                std::vector<std::uint32_t>& first, std::vector<CchDownArc>& arcs) {
-  topology_->ancestors(from, set);
+void CchSearchSpace::build_half(std::vector<std::uint32_t> members, std::vector<std::uint32_t>& set,
+                                std::vector<std::uint32_t>& first, std::vector<CchDownArc>& arcs) const {
+  set = std::move(members);
   // Every higher neighbour of a member is a member (an ancestor of an ancestor). Both lists are
   // ascending, so each neighbour's place in the set is found by galloping on from the last one's.
-  slots_.clear();
+  std::vector<std::uint32_t> slots;
   for (std::size_t i = 0; i < set.size(); ++i) {
     std::size_t at = i;
     for (std::uint32_t y : topology_->up(set[i])) {
@@ -49,19 +51,19 @@ void CchSearchSpace::build_half(std::span<const std::uint32_t> from, std::vector
           std::lower_bound(set.begin() + static_cast<std::ptrdiff_t>(at + step / 2),
                            set.begin() + static_cast<std::ptrdiff_t>(std::min(at + step, set.size() - 1)) + 1, y) -
           set.begin());
-      slots_.push_back(static_cast<std::uint32_t>(at));
+      slots.push_back(static_cast<std::uint32_t>(at));
     }
   }
   first.assign(set.size() + 1, 0);
-  for (std::uint32_t at : slots_) ++first[at + 1];
+  for (std::uint32_t at : slots) ++first[at + 1];
   for (std::size_t i = 1; i < first.size(); ++i) first[i] += first[i - 1];
   arcs.resize(first.back());
-  fill_.assign(first.begin(), first.end() - 1);
+  std::vector<std::uint32_t> fill(first.begin(), first.end() - 1);
   std::size_t next = 0;
   for (std::uint32_t x : set) {
     const std::uint32_t base = topology_->first_up(x);
     for (std::size_t i = 0; i < topology_->up(x).size(); ++i) {
-      arcs[fill_[slots_[next++]]++] = {x, base + static_cast<std::uint32_t>(i)};
+      arcs[fill[slots[next++]]++] = {x, base + static_cast<std::uint32_t>(i)};
     }
   }
 }
@@ -71,11 +73,11 @@ double CchSearchSpace::move_starts(std::vector<EdgePoint> starts) {
   std::vector<std::uint32_t> from;
   for (const EdgePoint& s : flat_.starts()) from.push_back(topology_->rank(s.vertex()));
   rewired_.clear();
-  std::vector<std::uint32_t> old_set;
-  topology_->ancestors(from, old_set);
-  if (old_set == up_set_) return 0.0;  // along the same edge, or onto one with the same ancestors
-  old_set.swap(up_set_);
-  build_half(from, up_set_, up_first_, up_arcs_);
+  std::vector<std::uint32_t> members;
+  topology_->ancestors(from, members);
+  if (members == up_set_) return 0.0;  // along the same edge, or onto one with the same ancestors
+  std::vector<std::uint32_t> old_set = std::move(up_set_);
+  build_half(std::move(members), up_set_, up_first_, up_arcs_);
   // A vertex that joined or left the upward half gained or lost its upward arcs.
   std::vector<std::uint32_t> moved;
   std::set_symmetric_difference(old_set.begin(), old_set.end(), up_set_.begin(), up_set_.end(), std::back_inserter(moved));
@@ -113,7 +115,7 @@ std::size_t CchSearchSpace::heap_bytes() const {
   return flat_.heap_bytes() + (up_set_.capacity() + up_first_.capacity() + down_set_.capacity() + down_first_.capacity()) *
                              sizeof(std::uint32_t) +
          (up_arcs_.capacity() + down_arcs_.capacity()) * sizeof(CchDownArc) + targets_.capacity() * sizeof(Target) +
-         rewired_.capacity() * sizeof(Vertex) + (slots_.capacity() + fill_.capacity()) * sizeof(std::uint32_t);
+         rewired_.capacity() * sizeof(Vertex);
 }
 
 }  // namespace corridor::planner

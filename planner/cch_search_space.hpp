@@ -1,8 +1,9 @@
 // One mission's search graph on a customizable contraction hierarchy: the arcs an upward search
 // from the start and a downward search to the goal can use, with the virtual start S and goal G
-// of SearchSpace. Every vertex reaches G at its true cost over the turn graph: a cheapest path
-// goes up from the start through the elimination tree's ancestors of the start, then down through
-// those of the goal (Dibbelt, Strasser & Wagner 2016, §6). This is D* Lite's graph at metro scale:
+// of SearchSpace. S, and every vertex of the upward half, reaches G at its true cost over the turn
+// graph: a cheapest path goes up from the start through the elimination tree's ancestors of the
+// start, then down through those of the goal (Dibbelt, Strasser & Wagner 2016, §6). Other
+// vertices' values are upper bounds at best: only cost_to_goal and the route are meaningful. This is D* Lite's graph at metro scale:
 // a few thousand vertices around two elimination-tree paths instead of the whole city.
 //
 // Vertices are CCH ranks (planner/cch_topology.hpp), then S, then G. The arcs:
@@ -177,10 +178,11 @@ class CchSearchSpace {
       }
     }
   }
-  // Builds a half over the ancestors of `from`: its members, and the arcs between members filed
-  // under their higher end (the upward half enters it by them, the downward half leaves by them).
-  void build_half(std::span<const std::uint32_t> from, std::vector<std::uint32_t>& set, std::vector<std::uint32_t>& first,
-                  std::vector<CchDownArc>& arcs);
+  // Builds a half from its members (the ancestors of its vertices, ascending), filing the arcs
+  // between members under their higher end (the upward half enters it by them, the downward half
+  // leaves by them).
+  void build_half(std::vector<std::uint32_t> members, std::vector<std::uint32_t>& set, std::vector<std::uint32_t>& first,
+                  std::vector<CchDownArc>& arcs) const;
 
   const CchMetric* metric_;
   const CchTopology* topology_;
@@ -192,7 +194,6 @@ class CchSearchSpace {
   std::vector<std::uint32_t> down_set_, down_first_;
   std::vector<CchDownArc> down_arcs_;
   std::vector<Vertex> rewired_;
-  std::vector<std::uint32_t> slots_, fill_;  // build_half's scratch
 };
 
 }  // namespace corridor::planner

@@ -3,6 +3,7 @@
 #include <metis.h>
 
 #include <algorithm>
+#include <limits>
 #include <numeric>
 #include <stdexcept>
 #include <string>
@@ -43,8 +44,15 @@ UndirectedGraph undirected(const maps::TurnGraph& turns) {
 std::vector<std::uint32_t> nested_dissection_ranks(const maps::TurnGraph& turns) {
   const std::size_t n = turns.vertex_count();
   std::vector<std::uint32_t> rank(n);
-  if (n == 0) return rank;
   UndirectedGraph g = undirected(turns);
+  if (g.adjacent.size() > static_cast<std::size_t>(std::numeric_limits<idx_t>::max())) {
+    throw std::length_error("turn graph too large for METIS: " + std::to_string(g.adjacent.size()) + " adjacencies");
+  }
+  // METIS 5.1 bisects without checking for a graph with no edges; any order serves one.
+  if (n < 2 || g.adjacent.empty()) {
+    std::iota(rank.begin(), rank.end(), 0u);
+    return rank;
+  }
   idx_t nv = static_cast<idx_t>(n);
   idx_t options[METIS_NOPTIONS];
   METIS_SetDefaultOptions(options);
@@ -91,6 +99,8 @@ CchTopology::CchTopology(const maps::TurnGraph& turns) : turns_(&turns) {
       auto& into = higher[h.front()];
       into.insert(into.end(), h.begin() + 1, h.end());
     }
+    // Arc ids, and kNoCchArc beyond them, must fit in 32 bits.
+    if (h.size() >= kNoCchArc - first_up_[r]) throw std::length_error("contraction hierarchy too large for 32-bit arc ids");
     first_up_[r + 1] = first_up_[r] + static_cast<std::uint32_t>(h.size());
   }
   up_head_.reserve(first_up_[n]);

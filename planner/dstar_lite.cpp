@@ -66,8 +66,9 @@ template <class Space>
 void BasicDStarLite<Space>::edges_changed(std::span<const EdgeId> edges) {
   bool start_affected = false;
   for (EdgeId e : edges) {
-    // Every arc whose cost can depend on e drives onto e (a turn onto e or one of its copies, or a
-    // goal arc on e), and so starts at a vertex turning onto e; or it leaves S.
+    // On the turn graph, every arc whose cost can depend on e drives onto e (a turn onto e or one of
+    // its copies, or a goal arc on e), and so starts at a vertex turning onto e; or it leaves S. On
+    // a CCH that is the goal arcs and S; the shortcuts e enters arrive through arcs_changed.
     space_.for_each_vertex_turning_onto(e, [&](Vertex u) { recompute_rhs(u); });
     start_affected = start_affected || space_.is_start_edge(e);
   }

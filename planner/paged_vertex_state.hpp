@@ -21,8 +21,10 @@ struct VertexState {
 
 class PagedVertexStates {
  public:
-  // 256 vertices (6 KiB) per page: vertex ids follow the Hilbert order of their nodes, so a local
-  // search fills few pages, and a page is small next to a search's own working set.
+  // 256 vertices (6 KiB) per page: turn-graph vertex ids follow the Hilbert order of their nodes,
+  // so a local search fills few pages, and a page is small next to a search's own working set. (On
+  // a CCH, ids are ranks: the top separators share pages, the lower ancestors take about one page
+  // per level.)
   static constexpr std::uint32_t kPageShift = 8;
   static constexpr std::uint32_t kPageSize = 1u << kPageShift;
 

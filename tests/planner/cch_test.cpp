@@ -2,8 +2,11 @@
 
 #include <random>
 
+#include "maps/graph_builder.hpp"
 #include "planner/cch_metric.hpp"
 #include "planner/cch_topology.hpp"
+#include "planner/dstar_lite.hpp"
+#include "planner/one_to_one_search.hpp"
 #include "tests/planner/test_graphs.hpp"
 
 namespace corridor::planner {
@@ -135,6 +138,53 @@ TEST(CchMetric, ShortcutsUnpackIntoTurnsOfTheirWeight) {
     }
   }
   EXPECT_GT(shortcuts, 50);
+}
+
+// The smallest map: one two-way street, two turn-graph vertices joined by the dead-end U-turns.
+// The order, the metric and the routes along it (either way, one through a U-turn) still agree
+// with Dijkstra.
+TEST(CchTopology, OneStreetMap) {
+  maps::GraphBuildInput in;
+  in.origin = {47.0, 9.5};
+  in.node_pos = {{0, 0}, {100, 0}};
+  in.node_osm = {OsmNodeId{1}, OsmNodeId{2}};
+  in.node_signalized = {0, 0};
+  maps::RoadSegment s;
+  s.from = 0;
+  s.to = 1;
+  s.first_point = 0;
+  in.points = {in.node_pos[0], in.node_pos[1]};
+  s.last_point = 1;
+  s.forward_speed_mps = s.backward_speed_mps = 10.0f;
+  s.way = OsmWayId{1};
+  in.segments.push_back(s);
+  const maps::RoadGraph g = maps::build_road_graph(in);
+  ASSERT_EQ(g.edge_count(), 2u);
+  const CchTopology t(g.turns());
+  EXPECT_EQ(t.vertex_count(), g.turns().vertex_count());
+  CostOverlay overlay(g);
+  const TravelCost cost(g, overlay, testing::free_turns(30.0));
+  const CchMetric metric(t, cost);
+  EXPECT_EQ(metric.invariant_violation(), "");
+  OneToOneSearch dijkstra;
+  for (const auto& [from, to] : {std::pair{10.0, 60.0}, std::pair{60.0, 10.0}}) {
+    const std::vector<EdgePoint> starts{{EdgeId{0}, from}}, goals{{EdgeId{0}, to}};
+    CchDStarLite dstar(metric, starts, goals);
+    dstar.replan();
+    const Route oracle = dijkstra.run(SearchSpace(cost, starts, goals), false);
+    EXPECT_EQ(dstar.cost_to_goal_s(), oracle.travel_time_s) << from << " -> " << to;
+    EXPECT_EQ(dstar.route().edges, oracle.edges) << from << " -> " << to;
+  }
+}
+
+// A metric over another map's hierarchy is refused, not computed with the wrong turns.
+TEST(CchMetric, RefusesAHierarchyOfAnotherGraph) {
+  const auto a = random_grid(1, 4, 4);
+  const auto b = random_grid(2, 4, 4);
+  CostOverlay overlay(b);
+  const TravelCost cost(b, overlay, {30.0});
+  const CchTopology t(a.turns());
+  EXPECT_THROW(CchMetric(t, cost), std::invalid_argument);
 }
 
 }  // namespace

@@ -76,16 +76,16 @@ TEST(DStarLite, InitialPlanMatchesDijkstraOnRandomGraphs) {
 // closures and reopenings, node and movement delay changes, and start moves, checked after every
 // replan. On the turn graph (eager and lazy raises), and on a contraction hierarchy, whose metric
 // is customized with each batch and checked against its own invariants.
-enum class Variant { eager, lazy, cch };
+enum class Variant { eager, lazy, cch, cch_lazy };
 
 // One D* Lite of either kind, fed the same reports.
 class AnyDStarLite {
  public:
   AnyDStarLite(Variant v, const TravelCost& cost, std::vector<EdgePoint> starts, std::vector<EdgePoint> goals) {
-    if (v == Variant::cch) {
+    if (v == Variant::cch || v == Variant::cch_lazy) {
       topology_.emplace(cost.graph().turns());
       metric_.emplace(*topology_, cost);
-      cch_.emplace(*metric_, std::move(starts), std::move(goals));
+      cch_.emplace(*metric_, std::move(starts), std::move(goals), DStarLiteOptions{v == Variant::cch_lazy});
     } else {
       flat_.emplace(cost, std::move(starts), std::move(goals), DStarLiteOptions{v == Variant::lazy});
     }
@@ -194,9 +194,15 @@ TEST_P(DStarLiteRepair, ReplanMatchesDijkstraAfterRandomUpdateSequences) {
   EXPECT_EQ(replans, kSequences * 25);
 }
 
-INSTANTIATE_TEST_SUITE_P(EagerLazyAndCch, DStarLiteRepair, ::testing::Values(Variant::eager, Variant::lazy, Variant::cch),
+INSTANTIATE_TEST_SUITE_P(EagerLazyAndCch, DStarLiteRepair,
+                         ::testing::Values(Variant::eager, Variant::lazy, Variant::cch, Variant::cch_lazy),
                          [](const ::testing::TestParamInfo<Variant>& p) {
-                           return p.param == Variant::lazy ? "lazy" : p.param == Variant::cch ? "cch" : "eager";
+                           switch (p.param) {
+                             case Variant::lazy: return "lazy";
+                             case Variant::cch: return "cch";
+                             case Variant::cch_lazy: return "cch_lazy";
+                             default: return "eager";
+                           }
                          });
 
 // A mission that touches a small part of a big graph holds a small part of its state: the per-vertex
