@@ -17,8 +17,7 @@ CchSearchSpace::CchSearchSpace(const CchMetric& metric, std::vector<EdgePoint> s
       for (const maps::TurnArc& in : turns.arcs_in(v)) {
         for (const maps::TurnArc& out : turns.arcs_out(in.other)) {
           if (out.other != v) continue;
-          const auto index = static_cast<std::uint32_t>(&out - turns.arcs_out(0).data());
-          targets_.push_back({topology_->rank(in.other), i, index});
+          targets_.push_back({topology_->rank(in.other), i, topology_->turn_arc_index(out)});
         }
       }
     };

@@ -77,7 +77,7 @@ CchTopology::CchTopology(const maps::TurnGraph& turns) : turns_(&turns) {
   if (n > 0) turn_arcs_base_ = turns.arcs_out(0).data();
   turn_arc_source_.resize(turns.arc_count());
   for (std::uint32_t u = 0; u < n; ++u) {
-    for (const maps::TurnArc& a : turns.arcs_out(u)) turn_arc_source_[static_cast<std::size_t>(&a - turn_arcs_base_)] = u;
+    for (const maps::TurnArc& a : turns.arcs_out(u)) turn_arc_source_[turn_arc_index(a)] = u;
   }
 
   // Contraction by rank: a vertex's higher neighbours become a clique. With the elimination tree
@@ -126,7 +126,7 @@ CchTopology::CchTopology(const maps::TurnGraph& turns) : turns_(&turns) {
       if (a.other == u) continue;  // a loop never shortens a path
       const std::uint32_t ru = rank_[u], rv = rank_[a.other];
       const std::uint32_t arc = find_arc(ru, rv);
-      const auto index = static_cast<std::uint32_t>(&a - turn_arcs_base_);
+      const std::uint32_t index = turn_arc_index(a);
       // The turn graph has at most one turn from a vertex to another.
       (ru < rv ? input_[arc].up : input_[arc].down) = index;
     }

@@ -63,6 +63,10 @@ class CchTopology {
   [[nodiscard]] const maps::TurnGraph& turns() const { return *turns_; }
   // The turn graph's out-arc with this index, and its source vertex.
   [[nodiscard]] const maps::TurnArc& turn_arc(std::uint32_t index) const { return turn_arcs_base_[index]; }
+  // The index of an arc of turns().arcs_out(...) (a reference into that array).
+  [[nodiscard]] std::uint32_t turn_arc_index(const maps::TurnArc& out_arc) const {
+    return static_cast<std::uint32_t>(&out_arc - turn_arcs_base_);
+  }
   [[nodiscard]] std::uint32_t turn_arc_source(std::uint32_t index) const { return turn_arc_source_[index]; }
 
   // Ranks from each of `from` up to the root, merged, ascending: the vertices an upward search
