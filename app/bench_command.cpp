@@ -9,6 +9,7 @@
 
 #include "app/cli_error.hpp"
 #include "app/map_options.hpp"
+#include "app/serve_command.hpp"
 #include "bench/replan_bench.hpp"
 #include "bench/serve_bench.hpp"
 #include "maps/synthetic_grid.hpp"
@@ -94,6 +95,7 @@ void register_bench_command(CLI::App& app) {
       ->capture_default_str();
   serve->add_option("--client-threads", s->second.client_threads, "load generator threads")->capture_default_str();
   serve->add_option("--server-threads", s->second.server_threads, "server I/O threads")->capture_default_str();
+  add_planner_graph_option(*serve, s->second.planner_graph);
   serve->callback([s] {
     const maps::RoadGraph graph = load_map_from_options(s->first);
     auto out = bench::run_serve_bench(graph, s->second);

@@ -29,6 +29,7 @@ struct ServeOptions {
   std::string config;
   int threads = 2;
   bool demo = false;
+  server::PlannerGraph planner_graph = server::PlannerGraph::automatic;
 };
 
 std::string random_token() {
@@ -89,6 +90,7 @@ void run_serve(const ServeOptions& o) {
   const std::filesystem::path map_file = o.map.map_file.empty() ? CORRIDOR_DEFAULT_MAP : o.map.map_file;
   server::DispatchConfig dispatch;
   dispatch.repair_threads = o.threads;  // as many as serve requests
+  dispatch.planner_graph = o.planner_graph;
   server::DispatchService service(graph, maps::signal_plans_for(map_file, graph), dispatch, &store, now());
   std::vector<server::StaticAsset> console;
   for (const auto& f : web::embedded_files()) {
@@ -125,6 +127,17 @@ void run_serve(const ServeOptions& o) {
 
 }  // namespace
 
+void add_planner_graph_option(CLI::App& cmd, server::PlannerGraph& out) {
+  const std::map<std::string, server::PlannerGraph> names{{"auto", server::PlannerGraph::automatic},
+                                                          {"turn-graph", server::PlannerGraph::turn_graph},
+                                                          {"hierarchy", server::PlannerGraph::hierarchy}};
+  cmd.add_option("--planner-graph", out,
+                 "what missions plan on: the turn graph, a contraction hierarchy shared by all missions, or auto (the "
+                 "hierarchy unless it comes out dense, as on a city-wide grid)")
+      ->transform(CLI::CheckedTransformer(names))
+      ->default_str("auto");
+}
+
 void register_serve_command(CLI::App& app) {
   // The API description does not depend on the map: a tiny grid stands in for one.
   app.add_subcommand("openapi", "Print the API's OpenAPI 3 description (what GET /v1/openapi.json serves)")->callback([] {
@@ -143,6 +156,7 @@ void register_serve_command(CLI::App& app) {
   cmd->add_option("--listen", o->listen, "HOST:PORT to listen on (port 0 picks a free one)")->capture_default_str();
   cmd->add_option("--config", o->config, "JSON config: tokens with roles, limits");
   cmd->add_option("--threads", o->threads, "I/O threads; as many repair plans in parallel after a congestion change")->capture_default_str();
+  add_planner_graph_option(*cmd, o->planner_graph);
   cmd->add_flag("--demo", o->demo,
                  "drive simulated vehicles along their missions' routes, and now and then congest a route ahead");
   cmd->callback([o] { run_serve(*o); });

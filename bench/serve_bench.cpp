@@ -209,6 +209,7 @@ json run_serve_bench(const maps::RoadGraph& graph, const ServeBenchConfig& c) {
   const auto now = [] { return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count(); };
   server::DispatchConfig dispatch;
   dispatch.repair_threads = c.server_threads;
+  dispatch.planner_graph = c.planner_graph;
   server::DispatchService service(graph, dispatch, &store, now());
   server::TokenAuth auth;
   auth.add(kToken, {"bench", server::kAllRoles, std::nullopt});
@@ -288,10 +289,12 @@ json run_serve_bench(const maps::RoadGraph& graph, const ServeBenchConfig& c) {
       1.0 / c.congestion_requests_per_s, deadline, started);
   std::vector<double> replan_latency_ms;  // per congestion request: until its last mission is repaired
   std::vector<double> slowest_replan_ms;  // per congestion request: its slowest single mission repair
+  std::vector<double> customization_ms;   // per congestion request: the hierarchy's customization
   sensor.on_body([&](const std::string& body) {
     const json answer = json::parse(body);
     replan_latency_ms.push_back(answer.value("replan_latency_ms", 0.0));
     slowest_replan_ms.push_back(answer.value("slowest_replan_ms", 0.0));
+    customization_ms.push_back(answer.value("customization_ms", 0.0));
   });
   for (auto& v : vehicles) v->start();
   if (per_request > 0) sensor.start();
@@ -322,6 +325,10 @@ json run_serve_bench(const maps::RoadGraph& graph, const ServeBenchConfig& c) {
 
   json out;
   out["graph"] = {{"nodes", graph.node_count()}, {"edges", graph.edge_count()}};
+  out["planner_graph"] = service.planner_graph() == server::PlannerGraph::hierarchy ? "hierarchy" : "turn_graph";
+  if (const auto* h = service.hierarchy()) {
+    out["hierarchy"] = {{"arcs", h->topology().arc_count()}, {"arcs_per_vertex", h->density()}, {"shared_bytes", h->memory_bytes()}};
+  }
   out["config"] = {{"vehicles", c.vehicles}, {"missions", c.missions}, {"congestion_edges_per_s", c.congestion_edges_per_s},
                    {"seconds", c.seconds}, {"rate_per_s", c.rate_per_s}, {"client_threads", c.client_threads}, {"server_threads", c.server_threads}};
   // In-process server and load generator: the resident set is both, the mission delta the server's.
@@ -340,6 +347,9 @@ json run_serve_bench(const maps::RoadGraph& graph, const ServeBenchConfig& c) {
   // Server side, per request: from its arrival to the last mission's repaired route.
   out["congestion"]["replan_latency_ms"] = latency_json(replan_latency_ms);
   out["congestion"]["slowest_mission_replan_ms"] = latency_json(slowest_replan_ms);
+  // On the hierarchy, per request: customizing the shared metric, once for all missions, before
+  // their repairs (not part of mission_replans).
+  out["congestion"]["customization_ms"] = latency_json(customization_ms);
   // Every single mission repair the congestion caused, from the server's own histogram.
   out["congestion"]["mission_replans"] =
       histogram_from_metrics(metrics_status == 200 ? metrics_text : "", "corridor_congestion_mission_replan_seconds");

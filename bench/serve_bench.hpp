@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "maps/road_graph.hpp"
+#include "server/dispatch_service.hpp"
 
 namespace corridor::bench {
 
@@ -20,6 +21,7 @@ struct ServeBenchConfig {
   double rate_per_s = 0.0;
   int client_threads = 1;
   int server_threads = 2;
+  server::PlannerGraph planner_graph = server::PlannerGraph::automatic;
   std::uint64_t seed = 1;
 };
 

@@ -31,6 +31,8 @@ CchSearchSpace::CchSearchSpace(const CchMetric& metric, std::vector<EdgePoint> s
   build_half(std::move(members), down_set_, down_first_, down_arcs_);
   from.clear();
   for (const EdgePoint& s : flat_.starts()) from.push_back(topology_->rank(s.vertex()));
+  std::sort(from.begin(), from.end());
+  start_ranks_ = from;
   topology_->ancestors(from, members);
   build_half(std::move(members), up_set_, up_first_, up_arcs_);
 }
@@ -71,7 +73,11 @@ double CchSearchSpace::move_starts(std::vector<EdgePoint> starts) {
   flat_.set_starts(std::move(starts));
   std::vector<std::uint32_t> from;
   for (const EdgePoint& s : flat_.starts()) from.push_back(topology_->rank(s.vertex()));
+  std::sort(from.begin(), from.end());
   rewired_.clear();
+  // Further along the same edges (most position reports): the same ancestors.
+  if (from == start_ranks_) return 0.0;
+  start_ranks_ = from;
   std::vector<std::uint32_t> members;
   topology_->ancestors(from, members);
   if (members == up_set_) return 0.0;  // along the same edge, or onto one with the same ancestors
@@ -82,6 +88,33 @@ double CchSearchSpace::move_starts(std::vector<EdgePoint> starts) {
   std::set_symmetric_difference(old_set.begin(), old_set.end(), up_set_.begin(), up_set_.end(), std::back_inserter(moved));
   for (std::uint32_t r : moved) rewired_.push_back(Vertex{r});
   return 0.0;
+}
+
+void CchSearchSpace::vertices_on_arcs(std::span<const std::uint32_t> arcs, std::vector<Vertex>& out) const {
+  out.clear();
+  if (std::is_sorted(arcs.begin(), arcs.end())) {
+    // Arc ids are grouped by their lower end: member x's arcs are [first_up(x), first_up(x + 1)).
+    // Each half's members are ascending, so one forward pass over the batch serves each half.
+    const auto scan = [&](const std::vector<std::uint32_t>& members, bool upward) {
+      auto it = arcs.begin();
+      for (std::uint32_t x : members) {
+        const std::uint32_t lo = topology_->first_up(x);
+        const std::uint32_t hi = topology_->first_up(x + 1);
+        it = std::lower_bound(it, arcs.end(), lo);
+        if (it == arcs.end()) return;
+        for (; it != arcs.end() && *it < hi; ++it) {
+          out.push_back(Vertex{upward ? x : topology_->head(*it)});
+          if (upward) it = std::lower_bound(it, arcs.end(), hi) - 1;  // one of x's arcs is enough
+        }
+      }
+    };
+    scan(up_set_, true);
+    scan(down_set_, false);
+  } else {
+    for (std::uint32_t arc : arcs) for_each_vertex_on_arc(arc, [&](Vertex u) { out.push_back(u); });
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
 }
 
 double CchSearchSpace::target_cost_s(const Target& t) const {
@@ -111,7 +144,7 @@ Route CchSearchSpace::route_along(const std::vector<Via>& vias) const {
 }
 
 std::size_t CchSearchSpace::heap_bytes() const {
-  return flat_.heap_bytes() + (up_set_.capacity() + up_first_.capacity() + down_set_.capacity() + down_first_.capacity()) *
+  return flat_.heap_bytes() + (start_ranks_.capacity() + up_set_.capacity() + up_first_.capacity() + down_set_.capacity() + down_first_.capacity()) *
                              sizeof(std::uint32_t) +
          (up_arcs_.capacity() + down_arcs_.capacity()) * sizeof(CchDownArc) + targets_.capacity() * sizeof(Target) +
          rewired_.capacity() * sizeof(Vertex);

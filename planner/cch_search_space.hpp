@@ -78,6 +78,10 @@ class CchSearchSpace {
     if (in_up(x)) f(Vertex{x});
     if (in_down(x)) f(Vertex{topology_->head(arc)});
   }
+  // The same for a batch of arcs, each vertex once, in ascending order, into `out` (cleared). A
+  // batch sorted by id (as the metric hands them out) is read only where the mission's vertices'
+  // arcs lie: a city-wide batch holds thousands of arcs, a mission's graph a few hundred vertices.
+  void vertices_on_arcs(std::span<const std::uint32_t> arcs, std::vector<Vertex>& out) const;
 
   // f(Vertex to, double cost_s, Via via) for every arc out of u.
   template <class F>
@@ -189,6 +193,7 @@ class CchSearchSpace {
   std::size_t n_;
   SearchSpace flat_;  // the starts and goals, checked and clamped, and the route builder
   std::vector<Target> targets_;  // by rank
+  std::vector<std::uint32_t> start_ranks_;  // the start vertices' ranks, ascending: the upward half's seeds
   std::vector<std::uint32_t> up_set_, up_first_;
   std::vector<CchDownArc> up_arcs_;
   std::vector<std::uint32_t> down_set_, down_first_;

@@ -79,7 +79,11 @@ template <class Space>
 void BasicDStarLite<Space>::arcs_changed(std::span<const std::uint32_t> arcs)
   requires std::is_same_v<Space, CchSearchSpace>
 {
-  for (std::uint32_t arc : arcs) space_.for_each_vertex_on_arc(arc, [&](Vertex u) { recompute_rhs(u); });
+  // Near the top of the hierarchy a vertex has hundreds of arcs, and a batch changes many of them:
+  // each vertex's rhs is re-derived once, not once per changed arc.
+  std::vector<Vertex> touched;
+  space_.vertices_on_arcs(arcs, touched);
+  for (Vertex u : touched) recompute_rhs(u);
 }
 
 template <class Space>

@@ -85,7 +85,8 @@ CongestionResult DispatchService::report_congestion(const std::vector<Congestion
     latest_update_[changes[i].first] = seq;
     if (expiry[i]) expiries_.emplace(*expiry[i], std::make_pair(changes[i].first, seq));
   }
-  const std::vector<MissionPtr> affected = apply_changes(changes, "congestion");
+  double customization_s = 0;
+  const std::vector<MissionPtr> affected = apply_changes(changes, "congestion", customization_s);
   DispatchEvent applied;
   applied.kind = "congestion_applied";
   applied.reason = std::to_string(changes.size()) + " edges";
@@ -95,23 +96,36 @@ CongestionResult DispatchService::report_congestion(const std::vector<Congestion
   std::vector<std::shared_ptr<CommitTicket>> durable;
   CongestionResult result = repair_plans(affected, now_s, started, durable);
   result.edges_changed = changes.size();
+  result.customization_s = customization_s;
   for (const auto& t : durable) t->wait();
   return result;
 }
 
 std::vector<DispatchService::MissionPtr> DispatchService::apply_changes(
-    const std::vector<std::pair<EdgeId, planner::EdgeCondition>>& changes, const std::string& reason) {
+    const std::vector<std::pair<EdgeId, planner::EdgeCondition>>& changes, const std::string& reason,
+    double& customization_s) {
   std::vector<EdgeId> edges;
   edges.reserve(changes.size());
   for (const auto& [e, condition] : changes) edges.push_back(e);
   std::vector<MissionPtr> affected;
   std::lock_guard costs(overlay_mutex_);
   for (const auto& [e, condition] : changes) overlay_.set_edge(e, condition);
+  // The metrics follow the overlay before any repair can read them: one customization per model,
+  // whatever the number of missions on it.
+  std::vector<std::pair<std::shared_ptr<const HierarchyModel>, ArcBatch>> batches;
+  if (hierarchy_) {
+    const auto started = std::chrono::steady_clock::now();
+    batches = hierarchy_->edges_changed(edges);
+    customization_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  }
   std::shared_lock registry(registry_mutex_);
   for (const auto& [vehicle, id] : active_by_vehicle_) {
     const MissionPtr& m = missions_.at(id);
     std::lock_guard lock(m->pending_mutex);
     m->pending_edges.insert(m->pending_edges.end(), edges.begin(), edges.end());
+    for (const auto& [model, arcs] : batches) {
+      if (model.get() == m->model) m->pending_arcs.push_back(arcs);
+    }
     m->pending_reason = reason;
     affected.push_back(m);
   }
@@ -197,7 +211,9 @@ void DispatchService::tick(double now_s) {
     if (!expired.empty()) {
       // Nobody waits for the tick's writes; a failure is logged by the queue.
       std::vector<std::shared_ptr<CommitTicket>> durable;
-      repair_plans(apply_changes(expired, "congestion_expired"), now_s, std::chrono::steady_clock::now(), durable);
+      double customization_s = 0;
+      repair_plans(apply_changes(expired, "congestion_expired", customization_s), now_s, std::chrono::steady_clock::now(),
+                   durable);
     }
   }
   Staged staged;

@@ -18,8 +18,11 @@ struct DispatchService::Mission {
   MissionRow row;
   std::optional<maps::LatLon> last_position;
   maps::Point2 destination_local;
-  std::unique_ptr<planner::TravelCost> cost;
-  std::unique_ptr<planner::DStarLite> planner;
+  MissionPlanner planner;
+  // The planner's hierarchy model, set before the mission is shared and never changed: congestion
+  // changes match their arc batches to missions by it without the mission's lock. An identity only;
+  // the planner holds the model itself.
+  const HierarchyModel* model = nullptr;
   planner::Route route;
   std::uint32_t revision = 0;
   std::vector<preemption::ScheduleEntry> final_schedule;  // kept when the engine forgets the mission
@@ -37,6 +40,7 @@ struct DispatchService::Mission {
   // repair sees exactly the costs it was told of.
   std::mutex pending_mutex;
   std::vector<EdgeId> pending_edges;
+  std::vector<ArcBatch> pending_arcs;  // the hierarchy's moved arcs, one batch per customization
   std::optional<std::string> pending_reason;
 };
 

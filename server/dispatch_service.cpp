@@ -84,6 +84,19 @@ DispatchService::DispatchService(const maps::RoadGraph& graph, std::unordered_ma
   // expected delay.
   overlay_.set_signal_delay(graph, config_.signal_delay_s);
   preemption::set_signal_costs(overlay_, graph, plans_, preemption::SignalCostRule::preempted);
+  if (!(config_.max_hierarchy_density > 0.0)) {
+    throw std::invalid_argument("max_hierarchy_density must be positive, not " + std::to_string(config_.max_hierarchy_density));
+  }
+  if (config_.planner_graph != PlannerGraph::turn_graph) {
+    const auto started = std::chrono::steady_clock::now();
+    hierarchy_ = std::make_unique<SharedHierarchy>(graph, overlay_);
+    const double took_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    const bool sparse = hierarchy_->density() <= config_.max_hierarchy_density;
+    spdlog::info("event=planner_graph choice={} arcs={} arcs_per_vertex={:.1f} built_s={:.2f}",
+                 sparse || config_.planner_graph == PlannerGraph::hierarchy ? "hierarchy" : "turn_graph",
+                 hierarchy_->topology().arc_count(), hierarchy_->density(), took_s);
+    if (!sparse && config_.planner_graph == PlannerGraph::automatic) hierarchy_.reset();
+  }
   for (EdgeId e : graph.edges()) edges_by_way_.emplace(graph.osm_way(e).v, e);
   if (config_.repair_threads > 1) {
     repair_pool_ = std::make_unique<boost::asio::thread_pool>(static_cast<std::size_t>(config_.repair_threads - 1));
@@ -274,20 +287,28 @@ void DispatchService::drain_preemption_events(Staged& staged) {
   for (const auto& [node, time_s] : touched) announce_signal_state(node, time_s);
 }
 
+MissionPlanner DispatchService::make_planner(const MissionRow& row, std::vector<planner::EdgePoint> starts,
+                                            std::vector<planner::EdgePoint> goals) {
+  if (hierarchy_) return {hierarchy_->acquire(vehicle_profile(row)), std::move(starts), std::move(goals)};
+  return {std::make_unique<planner::TravelCost>(graph_, overlay_, vehicle_profile(row)), std::move(starts), std::move(goals)};
+}
+
 std::optional<std::string> DispatchService::repair(Mission& m, const std::vector<planner::EdgePoint>* new_start) {
   std::shared_lock costs(overlay_mutex_);
   std::vector<EdgeId> changed;
+  std::vector<ArcBatch> arcs;
   std::optional<std::string> reason;
   {
     std::lock_guard lock(m.pending_mutex);
     changed = std::exchange(m.pending_edges, {});
+    arcs = std::exchange(m.pending_arcs, {});
     reason = std::exchange(m.pending_reason, std::nullopt);
   }
   // D* Lite must hear of each change exactly once, before its next repair.
-  if (!changed.empty()) m.planner->edges_changed(changed);
-  if (new_start != nullptr) m.planner->move_start(*new_start);
-  m.planner->replan();
-  m.route = m.planner->route();
+  m.planner.changed(changed, arcs);
+  if (new_start != nullptr) m.planner.move_start(*new_start);
+  m.planner.replan();
+  m.route = m.planner.route();
   return reason;
 }
 
@@ -372,15 +393,14 @@ MissionView DispatchService::create_mission(const MissionRequest& req, double no
             req.profile};
   m->last_position = origin;
   m->destination_local = to.point;
-  m->cost = std::make_unique<planner::TravelCost>(graph_, overlay_, vehicle_profile(m->row));
   Staged staged;
   {
     // Planned and registered under one view of the costs, so no congestion change falls between.
     std::shared_lock costs(overlay_mutex_);
-    m->planner = std::make_unique<planner::DStarLite>(*m->cost, endpoints(from, Role::start, origin_heading),
-                                                      endpoints(to, Role::goal, std::nullopt));
-    m->planner->replan();
-    m->route = m->planner->route();
+    m->planner = make_planner(m->row, endpoints(from, Role::start, origin_heading), endpoints(to, Role::goal, std::nullopt));
+    m->model = m->planner.model();
+    m->planner.replan();
+    m->route = m->planner.route();
     m->route_time_s = now_s;
     if (!m->route.found) throw unprocessable("unreachable", "the destination cannot be reached from the origin");
     stage(staged, [row = m->row](Store& store) { store.insert_mission(row); });
@@ -667,12 +687,11 @@ void DispatchService::restore(double now_s) {
       m->row = row;
       m->last_position = start;
       m->destination_local = to.point;
-      m->cost = std::make_unique<planner::TravelCost>(graph_, overlay_, vehicle_profile(row));
-      m->planner = std::make_unique<planner::DStarLite>(
-          *m->cost, endpoints(from, Role::start, last ? last->heading_deg : std::nullopt),
-          endpoints(to, Role::goal, std::nullopt));
-      m->planner->replan();
-      m->route = m->planner->route();
+      m->planner = make_planner(row, endpoints(from, Role::start, last ? last->heading_deg : std::nullopt),
+                                endpoints(to, Role::goal, std::nullopt));
+      m->model = m->planner.model();
+      m->planner.replan();
+      m->route = m->planner.route();
       m->route_time_s = now_s;
       m->history = restored_history(row.id);
       m->revision = m->history.empty() ? 0 : m->history.back().view.revision;

@@ -21,6 +21,8 @@
 #include "server/api_error.hpp"
 #include "server/commit_queue.hpp"
 #include "server/dispatch_types.hpp"
+#include "server/mission_planner.hpp"
+#include "server/shared_hierarchy.hpp"
 #include "server/store.hpp"
 #include "server/vehicle_tracker.hpp"
 
@@ -30,12 +32,30 @@ class thread_pool;
 
 namespace corridor::server {
 
+// The graph every mission's D* Lite searches.
+enum class PlannerGraph {
+  // The contraction hierarchy where it came out sparse (a road network's small separators: at
+  // most `max_hierarchy_density` arcs per vertex), else the turn graph.
+  automatic,
+  // The turn graph itself: nothing shared, no preprocessing; a repair at metro scale may re-derive
+  // a large part of the city.
+  turn_graph,
+  // A contraction hierarchy over the turn graph, shared by all missions: each congestion batch is
+  // customized once, and a mission's repair touches the few hundred vertices above its start and
+  // goal. Costly on maps without small separators (a city-wide grid).
+  hierarchy,
+};
+
 struct DispatchConfig {
   double snap_max_distance_m = 200.0;
   double arrival_radius_m = 30.0;  // closer than this to the destination completes the mission
   double signal_delay_s = 15.0;    // expected delay at a signalized intersection without a plan, for routing
   // Threads that repair missions' plans after a congestion change, the calling one included.
   int repair_threads = 2;
+  PlannerGraph planner_graph = PlannerGraph::automatic;
+  // Arcs per vertex above which `automatic` keeps the turn graph: road networks measure 6 to 10, a
+  // city-wide grid about 30, where customizing a batch costs 20x more (docs/routing.md).
+  double max_hierarchy_density = 16.0;
   preemption::PreemptionConfig preemption;
 };
 
@@ -77,6 +97,9 @@ class DispatchService {
   // "program", and the program step; a simulator mirrors these onto its own lights.
   [[nodiscard]] std::pair<std::string, std::size_t> signal_mode(NodeId node) const;
   [[nodiscard]] std::size_t active_mission_count() const;
+  // The graph the missions are planned on (never `automatic`), and the hierarchy when it is that.
+  [[nodiscard]] PlannerGraph planner_graph() const { return hierarchy_ ? PlannerGraph::hierarchy : PlannerGraph::turn_graph; }
+  [[nodiscard]] const SharedHierarchy* hierarchy() const { return hierarchy_.get(); }
   // What a console shows of a signal: "normal" (its program), "scheduled" (a hold is planned),
   // "held" (green for an emergency vehicle) or "recovering" (yellow and all-red back to the program).
   [[nodiscard]] std::string signal_state(NodeId node) const;
@@ -105,9 +128,10 @@ class DispatchService {
   void announce_route(Mission& m, const std::string& reason, double now_s, Staged& staged);
   void publish_route(Mission& m, const std::string& reason, double now_s, Staged& staged);
   void retime_signals(Mission& m, double now_s, Staged& staged);
-  // Applies edge changes to the overlay and tells every active planner of them; returns those missions.
+  // Applies edge changes to the overlay (and customizes the hierarchy's metrics) and tells every
+  // active planner of them; returns those missions. Adds the customization's time to `customization_s`.
   std::vector<MissionPtr> apply_changes(const std::vector<std::pair<EdgeId, planner::EdgeCondition>>& changes,
-                                        const std::string& reason);
+                                        const std::string& reason, double& customization_s);
   // Repairs those plans, spread over the repair threads, one mission lock at a time each, and
   // publishes new routes; collects the write tickets.
   CongestionResult repair_plans(const std::vector<MissionPtr>& missions, double now_s, std::chrono::steady_clock::time_point started,
@@ -121,6 +145,9 @@ class DispatchService {
   [[nodiscard]] std::string signal_state_locked(NodeId node) const;
   MissionView view(const Mission& m) const;
   static planner::VehicleProfile vehicle_profile(const MissionRow& row);
+  // A planned mission's planner on the service's graph; call under the overlay's shared lock.
+  MissionPlanner make_planner(const MissionRow& row, std::vector<planner::EdgePoint> starts,
+                              std::vector<planner::EdgePoint> goals);
   // Ends a mission in memory; the caller stores the new state (stage_state) first.
   void finish(Mission& m, MissionState state, double now_s, Staged& staged);
   void stage_state(const Mission& m, MissionState state, double now_s, Staged& staged) const;
@@ -144,9 +171,11 @@ class DispatchService {
   const std::unordered_map<NodeId, maps::SignalPlan> plans_;
   std::unordered_multimap<std::int64_t, EdgeId> edges_by_way_;
 
-  // Read by every planner's repair (shared), written by congestion changes (exclusive).
+  // Read by every planner's repair (shared), written by congestion changes (exclusive); the
+  // hierarchy's metrics follow the overlay under the same lock.
   mutable std::shared_mutex overlay_mutex_;
   planner::CostOverlay overlay_;
+  std::unique_ptr<SharedHierarchy> hierarchy_;  // null when missions plan on the turn graph
 
   // The signals and the engine that arbitrates between missions.
   mutable std::mutex preemption_mutex_;

@@ -119,6 +119,9 @@ struct CongestionResult {
   double slowest_replan_s = 0;
   // Each repaired mission's D* Lite repair time, in no particular order: the per-replan latency.
   std::vector<double> mission_replan_s;
+  // Customizing the shared hierarchy's metrics to the batch, once for all missions (0 on the turn
+  // graph); paid under the overlay's exclusive lock, before the repairs.
+  double customization_s = 0;
 };
 
 // What the service tells listeners (the WebSocket stream): kind and mission, with a JSON payload

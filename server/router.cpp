@@ -206,11 +206,13 @@ Router::Router(DispatchService& service, TokenAuth auth, RouterConfig config, Cl
         metrics_.observe("congestion_replan_seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
         metrics_.count("replans_total", static_cast<double>(res.missions_replanned));
         for (double s : res.mission_replan_s) metrics_.observe("congestion_mission_replan_seconds", s);
+        if (service_.hierarchy() != nullptr) metrics_.observe("congestion_customization_seconds", res.customization_s);
         return json_response(200, {{"edges_changed", res.edges_changed},
                                    {"missions_replanned", res.missions_replanned},
                                    {"routes_changed", res.routes_changed},
                                    {"replan_latency_ms", res.replan_latency_s * 1e3},
-                                   {"slowest_replan_ms", res.slowest_replan_s * 1e3}});
+                                   {"slowest_replan_ms", res.slowest_replan_s * 1e3},
+                                   {"customization_ms", res.customization_s * 1e3}});
       }, kBlocking);
   add("POST", "/v1/signals/{id}/counts", kSensor, "Detector counts for a signal's approach",
       [this](const Principal&, const Match& m, const HttpRequest& r) {

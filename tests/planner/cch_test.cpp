@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include "maps/graph_builder.hpp"
@@ -138,6 +139,40 @@ TEST(CchMetric, ShortcutsUnpackIntoTurnsOfTheirWeight) {
     }
   }
   EXPECT_GT(shortcuts, 50);
+}
+
+// A batch of moved arcs names the mission's vertices whose arcs use them, each once: read where
+// the mission's vertices lie when the batch is sorted (as the metric hands it out), arc by arc
+// otherwise, and both agree with asking each arc on its own.
+TEST(CchSearchSpace, VerticesOnABatchOfArcsAreEachArcsOnce) {
+  const auto g = random_grid(7, 12, 12);
+  CostOverlay overlay(g);
+  const TravelCost cost(g, overlay, testing::oracle_profile(7, 25.0));
+  const CchTopology t(g.turns());
+  const CchMetric metric(t, cost);
+  std::mt19937 rng(3);
+  int found = 0;
+  for (int trial = 0; trial < 50; ++trial) {
+    const EdgeId from{static_cast<std::uint32_t>(rng() % g.edge_count())};
+    const EdgeId to{static_cast<std::uint32_t>(rng() % g.edge_count())};
+    const CchSearchSpace space(metric, {{from, 0.0}}, {{to, g.length_m(to)}});
+    std::vector<std::uint32_t> batch;
+    for (std::uint32_t arc = 0; arc < t.arc_count(); ++arc) {
+      if (rng() % 4 == 0) batch.push_back(arc);
+    }
+    std::vector<Vertex> expected;
+    for (std::uint32_t arc : batch) space.for_each_vertex_on_arc(arc, [&](Vertex u) { expected.push_back(u); });
+    std::sort(expected.begin(), expected.end());
+    expected.erase(std::unique(expected.begin(), expected.end()), expected.end());
+    std::vector<Vertex> sorted_batch, shuffled_batch;
+    space.vertices_on_arcs(batch, sorted_batch);
+    std::shuffle(batch.begin(), batch.end(), rng);
+    space.vertices_on_arcs(batch, shuffled_batch);
+    EXPECT_EQ(sorted_batch, expected) << "trial " << trial;
+    EXPECT_EQ(shuffled_batch, expected) << "trial " << trial;
+    found += static_cast<int>(expected.size());
+  }
+  EXPECT_GT(found, 500);
 }
 
 // The smallest map: one two-way street, two turn-graph vertices joined by the dead-end U-turns.

@@ -3,10 +3,12 @@
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 
+#include <cmath>
 #include <filesystem>
 #include <atomic>
 #include <map>
 #include <random>
+#include <set>
 #include <thread>
 
 #include "maps/intersection_geometry.hpp"
@@ -291,6 +293,130 @@ TEST(DispatchService, RepairThreadsDoNotChangeTheRepairedRoutes) {
   DispatchConfig bad;
   bad.repair_threads = 0;
   EXPECT_THROW(DispatchService(grid(), bad, nullptr, 0.0), std::invalid_argument);
+}
+
+// The missions' graph changes how a repair works, not what it finds: a service on the turn graph
+// and one on the shared hierarchy, given the same missions (two profiles, three top speeds, so
+// three metrics), congestion, closures, expiries and positions, keep routes of the same cost after
+// every step. The turn-graph planner is itself checked against Dijkstra (above, and in the
+// planner's tests).
+TEST(DispatchService, HierarchyAndTurnGraphKeepRoutesOfTheSameCost) {
+  DispatchConfig flat_config;
+  flat_config.planner_graph = PlannerGraph::turn_graph;
+  DispatchConfig cch_config;
+  cch_config.planner_graph = PlannerGraph::hierarchy;
+  DispatchService flat(grid(), flat_config, nullptr, 0.0);
+  DispatchService cch(grid(), cch_config, nullptr, 0.0);
+  ASSERT_EQ(flat.planner_graph(), PlannerGraph::turn_graph);
+  ASSERT_EQ(cch.planner_graph(), PlannerGraph::hierarchy);
+  EXPECT_EQ(flat.hierarchy(), nullptr);
+  ASSERT_NE(cch.hierarchy(), nullptr);
+
+  const auto n = static_cast<std::uint32_t>(grid().node_count());
+  std::mt19937 rng(17);
+  std::vector<MissionId> ids;
+  for (int i = 0; i < 6; ++i) {
+    MissionRequest r = request("v-" + std::to_string(i));
+    r.origin = node_ll(NodeId{static_cast<std::uint32_t>(rng() % n)});
+    r.destination = node_ll(NodeId{static_cast<std::uint32_t>(rng() % n)});
+    r.profile = i % 2 == 0 ? "ambulance" : "fire_engine";
+    r.vmax_kmh = i < 4 ? 120.0 : 60.0;
+    const MissionView a = flat.create_mission(r, 0.0);
+    const MissionView b = cch.create_mission(r, 0.0);
+    ASSERT_EQ(a.id, b.id);
+    EXPECT_NEAR(a.route.travel_time_s, b.route.travel_time_s, 1e-6 * a.route.travel_time_s);
+    ids.push_back(a.id);
+  }
+  // ambulance and fire engine at 120 km/h, both at 60 km/h: four cost models.
+  EXPECT_EQ(cch.hierarchy()->models_in_use(), 4u);
+
+  const auto same_costs = [&](const std::string& when) {
+    for (MissionId id : ids) {
+      const MissionView a = flat.mission(id);
+      const MissionView b = cch.mission(id);
+      ASSERT_EQ(a.state, b.state) << when << ", mission " << id;
+      if (a.state != MissionState::active) continue;
+      ASSERT_EQ(a.route.found, b.route.found) << when << ", mission " << id;
+      if (!a.route.found) continue;  // closed in: no route on either
+      EXPECT_NEAR(a.route.travel_time_s, b.route.travel_time_s, 1e-6 * std::max(1.0, a.route.travel_time_s))
+          << when << ", mission " << id;
+    }
+  };
+  std::uniform_real_distribution<double> factor(0.5, 5.0);
+  double now = 1.0;
+  for (int step = 0; step < 40; ++step) {
+    now += 3.0;
+    std::vector<CongestionUpdate> batch;
+    for (int j = 0; j < 12; ++j) {
+      CongestionUpdate u;
+      u.edge = EdgeId{static_cast<std::uint32_t>(rng() % grid().edge_count())};
+      if (j == 0) {
+        u.speed_kmh = 0.0;  // a closure
+      } else {
+        u.factor = factor(rng);
+      }
+      if (j % 3 == 0) u.expires_in_s = 10.0;
+      batch.push_back(u);
+    }
+    const CongestionResult a = flat.report_congestion(batch, now);
+    const CongestionResult b = cch.report_congestion(batch, now);
+    EXPECT_EQ(a.missions_replanned, b.missions_replanned);
+    EXPECT_EQ(a.customization_s, 0.0);
+    EXPECT_GT(b.customization_s, 0.0);
+    same_costs("after batch " + std::to_string(step));
+    // Each vehicle moves half way along its route's second edge now and then.
+    if (step % 4 == 1) {
+      for (MissionId id : ids) {
+        const MissionView m = flat.mission(id);
+        if (m.state != MissionState::active || m.route.edges.size() < 3) continue;
+        PositionReport p;
+        p.vehicle_id = m.vehicle_id;
+        const EdgeId e = m.route.edges[1];
+        p.position = grid().projection().to_lat_lon(grid().point_along(e, grid().length_m(e) / 2));
+        p.timestamp_s = now;
+        (void)flat.report_position(p, now);
+        (void)cch.report_position(p, now);
+      }
+      same_costs("after positions at batch " + std::to_string(step));
+    }
+    flat.tick(now);
+    cch.tick(now);  // expiries: a change like any other
+    same_costs("after the tick at batch " + std::to_string(step));
+  }
+  // A model lives as long as a mission uses it.
+  for (MissionId id : {ids[4], ids[5]}) {
+    if (cch.mission(id).state == MissionState::active) (void)cch.cancel_mission(id, now);
+  }
+  std::set<std::pair<std::string, double>> in_use;
+  for (const MissionView& m : cch.missions(MissionState::active)) in_use.insert({m.profile, m.vmax_kmh});
+  EXPECT_EQ(cch.hierarchy()->models_in_use(), in_use.size());
+  EXPECT_FALSE(in_use.count({"ambulance", 60.0}) || in_use.count({"fire_engine", 60.0}));
+}
+
+// `automatic` takes the hierarchy where it came out sparse, and the turn graph where it did not.
+TEST(DispatchService, AutomaticPlannerGraphKeepsTheTurnGraphWhereTheHierarchyIsDense) {
+  DispatchService sparse(grid(), {}, nullptr, 0.0);
+  ASSERT_EQ(sparse.planner_graph(), PlannerGraph::hierarchy);
+  const double density = sparse.hierarchy()->density();
+  EXPECT_GT(density, 1.0);
+  EXPECT_LE(density, DispatchConfig{}.max_hierarchy_density);
+
+  DispatchConfig strict;
+  strict.max_hierarchy_density = density * 0.99;
+  DispatchService dense(grid(), strict, nullptr, 0.0);
+  EXPECT_EQ(dense.planner_graph(), PlannerGraph::turn_graph);
+  EXPECT_EQ(dense.hierarchy(), nullptr);
+  const MissionView m = dense.create_mission(request("amb-9"), 0.0);
+  EXPECT_TRUE(m.route.found);
+  // Asked for by name, the hierarchy is used whatever its density.
+  strict.planner_graph = PlannerGraph::hierarchy;
+  EXPECT_EQ(DispatchService(grid(), strict, nullptr, 0.0).planner_graph(), PlannerGraph::hierarchy);
+
+  for (double bad : {0.0, -1.0, std::nan("")}) {
+    DispatchConfig c;
+    c.max_hierarchy_density = bad;
+    EXPECT_THROW(DispatchService(grid(), c, nullptr, 0.0), std::invalid_argument) << bad;
+  }
 }
 
 // An expiry ends only the update it came with: a later closure without expiry stays in force.
