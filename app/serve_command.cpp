@@ -145,7 +145,9 @@ void register_serve_command(CLI::App& app) {
     spec.rows = 2;
     spec.cols = 2;
     const maps::RoadGraph graph = maps::make_perturbed_grid(spec);
-    server::DispatchService service(graph, {}, nullptr, 0.0);
+    server::DispatchConfig config;
+    config.planner_graph = server::PlannerGraph::turn_graph;  // nothing is planned here
+    server::DispatchService service(graph, config, nullptr, 0.0);
     const server::Router router(service, {}, {}, [] { return 0.0; });
     std::cout << router.openapi().dump(2) << std::endl;
   });

@@ -89,7 +89,10 @@ DispatchService::DispatchService(const maps::RoadGraph& graph, std::unordered_ma
   }
   if (config_.planner_graph != PlannerGraph::turn_graph) {
     const auto started = std::chrono::steady_clock::now();
-    hierarchy_ = std::make_unique<SharedHierarchy>(graph, overlay_);
+    if (config_.max_hierarchy_models < 1) {
+      throw std::invalid_argument("max_hierarchy_models must be at least 1, not " + std::to_string(config_.max_hierarchy_models));
+    }
+    hierarchy_ = std::make_unique<SharedHierarchy>(graph, overlay_, config_.max_hierarchy_models);
     const double took_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     const bool sparse = hierarchy_->density() <= config_.max_hierarchy_density;
     spdlog::info("event=planner_graph choice={} arcs={} arcs_per_vertex={:.1f} built_s={:.2f}",
@@ -289,8 +292,15 @@ void DispatchService::drain_preemption_events(Staged& staged) {
 
 MissionPlanner DispatchService::make_planner(const MissionRow& row, std::vector<planner::EdgePoint> starts,
                                             std::vector<planner::EdgePoint> goals) {
-  if (hierarchy_) return {hierarchy_->acquire(vehicle_profile(row)), std::move(starts), std::move(goals)};
-  return {std::make_unique<planner::TravelCost>(graph_, overlay_, vehicle_profile(row)), std::move(starts), std::move(goals)};
+  planner::VehicleProfile profile = vehicle_profile(row);
+  if (hierarchy_) {
+    if (auto model = hierarchy_->acquire(profile)) return {std::move(model), std::move(starts), std::move(goals)};
+    // Every model the hierarchy may hold is in use by other cost models (each is one more
+    // customization per congestion batch, and 24 bytes per arc): this one plans on the turn graph.
+    spdlog::info("event=mission_on_turn_graph mission={} reason=hierarchy_models_in_use models={}", row.id,
+                 hierarchy_->models_in_use());
+  }
+  return {std::make_unique<planner::TravelCost>(graph_, overlay_, std::move(profile)), std::move(starts), std::move(goals)};
 }
 
 std::optional<std::string> DispatchService::repair(Mission& m, const std::vector<planner::EdgePoint>* new_start) {
@@ -466,17 +476,24 @@ void DispatchService::stage_state(const Mission& m, MissionState state, double n
 void DispatchService::finish(Mission& m, MissionState state, double now_s, Staged& staged) {
   m.row.state = state;
   m.row.updated_s = now_s;
-  m.planner.reset();  // a finished mission keeps its last route, not its search state
+  {
+    // Out of the active list first: no congestion change queues anything for it after this.
+    std::lock_guard lock(registry_mutex_);
+    active_by_vehicle_.erase(m.row.vehicle_id);
+  }
+  // A finished mission keeps its last route, not its search state nor its hold on a shared model.
+  m.planner.reset();
+  {
+    std::lock_guard lock(m.pending_mutex);
+    m.pending_edges = {};
+    m.pending_arcs = {};
+  }
   {
     std::lock_guard lock(preemption_mutex_);
     preemption_.cancel(m.row.id, now_s);
     m.final_schedule = preemption_.schedule(m.row.id);
     preemption_.forget(m.row.id, now_s);
     drain_preemption_events(staged);
-  }
-  {
-    std::lock_guard lock(registry_mutex_);
-    active_by_vehicle_.erase(m.row.vehicle_id);
   }
   DispatchEvent e;
   e.kind = state == MissionState::completed ? "mission_completed" : "mission_cancelled";

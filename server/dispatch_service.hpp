@@ -56,6 +56,10 @@ struct DispatchConfig {
   // Arcs per vertex above which `automatic` keeps the turn graph: road networks measure 6 to 10, a
   // city-wide grid about 30, where customizing a batch costs 20x more (docs/routing.md).
   double max_hierarchy_density = 16.0;
+  // Cost models (a profile at a top speed) the hierarchy keeps a metric for at once; a mission of
+  // yet another one plans on the turn graph. Each costs a customization per congestion batch and
+  // 24 bytes per arc (30 MB on Porto); top speeds are the client's to choose.
+  int max_hierarchy_models = 4;
   preemption::PreemptionConfig preemption;
 };
 
@@ -158,8 +162,8 @@ class DispatchService {
   void restore(double now_s);
 
   // Locks, always taken in this order (never one while holding a later one):
-  //   create_mutex_ | congestion_mutex_  ->  Mission::mutex  ->  overlay_mutex_  ->  preemption_mutex_
-  //   ->  registry_mutex_  ->  Mission::pending_mutex  ->  listeners_mutex_
+  //   create_mutex_ | congestion_mutex_  ->  Mission::mutex  ->  overlay_mutex_  ->  SharedHierarchy's own
+  //   ->  preemption_mutex_  ->  registry_mutex_  ->  Mission::pending_mutex  ->  listeners_mutex_
   // Each mission's planner is confined to its own Mission::mutex, so missions are served in parallel.
   const maps::RoadGraph& graph_;
   DispatchConfig config_;

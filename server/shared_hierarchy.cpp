@@ -2,8 +2,8 @@
 
 namespace corridor::server {
 
-SharedHierarchy::SharedHierarchy(const maps::RoadGraph& graph, const planner::CostOverlay& overlay)
-    : graph_(graph), overlay_(overlay), topology_(graph.turns()) {}
+SharedHierarchy::SharedHierarchy(const maps::RoadGraph& graph, const planner::CostOverlay& overlay, std::size_t max_models)
+    : graph_(graph), overlay_(overlay), topology_(graph.turns()), max_models_(max_models) {}
 
 double SharedHierarchy::density() const {
   return topology_.vertex_count() == 0 ? 0.0
@@ -18,6 +18,7 @@ std::shared_ptr<const HierarchyModel> SharedHierarchy::acquire(const planner::Ve
   if (auto it = models_.find(key); it != models_.end()) {
     if (auto model = it->second.lock()) return model;
   }
+  if (models_.size() >= max_models_) return nullptr;
   auto model = std::make_shared<HierarchyModel>(topology_, graph_, overlay_, profile);
   models_[key] = model;
   return model;

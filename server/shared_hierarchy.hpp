@@ -39,22 +39,25 @@ struct HierarchyModel {
 class SharedHierarchy {
  public:
   // Builds the topology (a nested-dissection order and its contraction; 0.5 s on a metro area).
-  SharedHierarchy(const maps::RoadGraph& graph, const planner::CostOverlay& overlay);
+  // At most `max_models` metrics are kept at once.
+  SharedHierarchy(const maps::RoadGraph& graph, const planner::CostOverlay& overlay, std::size_t max_models);
 
   [[nodiscard]] const planner::CchTopology& topology() const { return topology_; }
   // Arcs per vertex: how dense the contraction came out. Road networks with small separators
   // (rivers, ring roads, bridges) stay below 10; a city-wide grid has none and reaches 30.
   [[nodiscard]] double density() const;
 
-  // The model for this profile: the one in use, or a new one (a full customization). Call with the
-  // overlay at least share-locked. Throws what TravelCost throws for a bad profile.
+  // The model for this profile: the one in use, or a new one (a full customization); null when
+  // `max_models` other models are in use. Call with the overlay at least share-locked. Throws what
+  // TravelCost throws for a bad profile.
   std::shared_ptr<const HierarchyModel> acquire(const planner::VehicleProfile& profile);
 
   // The overlay changed these edges' conditions; call under its exclusive lock. Customizes every
   // model in use and returns each one's moved arcs (models where none moved are left out).
   std::vector<std::pair<std::shared_ptr<const HierarchyModel>, ArcBatch>> edges_changed(std::span<const EdgeId> edges);
 
-  // Models in use now, and the bytes of the topology and of their metrics.
+  // Models in use now, and the bytes of the topology and of their metrics (the latter with the
+  // overlay at least share-locked, or with nothing else running: it reads the metrics' buffers).
   [[nodiscard]] std::size_t models_in_use() const;
   [[nodiscard]] std::size_t memory_bytes() const;
 
@@ -62,6 +65,7 @@ class SharedHierarchy {
   const maps::RoadGraph& graph_;
   const planner::CostOverlay& overlay_;
   planner::CchTopology topology_;
+  std::size_t max_models_;
   // Guards models_: acquire runs under the overlay's shared lock, so two may run at once.
   mutable std::mutex mutex_;
   // By the profile's JSON (every field that prices a turn or an edge).

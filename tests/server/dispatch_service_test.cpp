@@ -181,10 +181,15 @@ TEST(DispatchService, CongestionOnTheRouteChangesIt) {
 // Missions are served in parallel (one lock per mission), so several threads post positions,
 // congestion, counts and reads at once; afterwards every plan must still be the optimal route
 // under the final costs (the Dijkstra oracle), and every position must be stored. Run under TSan too.
-TEST(DispatchService, ConcurrentReportsKeepEveryPlanOptimal) {
+class ConcurrentReports : public testing::TestWithParam<PlannerGraph> {};
+
+TEST_P(ConcurrentReports, KeepEveryPlanOptimal) {
   TempDb db;
   Store store(db.path());
-  DispatchService service(grid(), {}, &store, 0.0);
+  DispatchConfig config;
+  config.planner_graph = GetParam();
+  DispatchService service(grid(), config, &store, 0.0);
+  ASSERT_EQ(service.planner_graph(), GetParam());
   const auto n = static_cast<std::uint32_t>(grid().node_count());
   std::mt19937 rng(5);
   const auto pick = [&](std::uint32_t from) { return NodeId{from + static_cast<std::uint32_t>(rng() % (n / 2))}; };
@@ -264,6 +269,11 @@ TEST(DispatchService, ConcurrentReportsKeepEveryPlanOptimal) {
   EXPECT_GT(positions.load(), 300);
 }
 
+INSTANTIATE_TEST_SUITE_P(DispatchService, ConcurrentReports, testing::Values(PlannerGraph::turn_graph, PlannerGraph::hierarchy),
+                         [](const testing::TestParamInfo<PlannerGraph>& p) {
+                           return p.param == PlannerGraph::hierarchy ? std::string("hierarchy") : std::string("turn_graph");
+                         });
+
 // The repair pool changes who repairs, not what: one thread and four give the same routes.
 TEST(DispatchService, RepairThreadsDoNotChangeTheRepairedRoutes) {
   std::vector<std::vector<std::vector<EdgeId>>> routes;
@@ -296,8 +306,9 @@ TEST(DispatchService, RepairThreadsDoNotChangeTheRepairedRoutes) {
 }
 
 // The missions' graph changes how a repair works, not what it finds: a service on the turn graph
-// and one on the shared hierarchy, given the same missions (two profiles, three top speeds, so
-// three metrics), congestion, closures, expiries and positions, keep routes of the same cost after
+// and one on the shared hierarchy, given the same missions (two profiles at two top speeds: four
+// cost models, of which the hierarchy holds at most three, so the fourth plans on the turn graph
+// inside it), congestion, closures, expiries and positions, keep routes of the same cost after
 // every step. The turn-graph planner is itself checked against Dijkstra (above, and in the
 // planner's tests).
 TEST(DispatchService, HierarchyAndTurnGraphKeepRoutesOfTheSameCost) {
@@ -305,6 +316,7 @@ TEST(DispatchService, HierarchyAndTurnGraphKeepRoutesOfTheSameCost) {
   flat_config.planner_graph = PlannerGraph::turn_graph;
   DispatchConfig cch_config;
   cch_config.planner_graph = PlannerGraph::hierarchy;
+  cch_config.max_hierarchy_models = 3;
   DispatchService flat(grid(), flat_config, nullptr, 0.0);
   DispatchService cch(grid(), cch_config, nullptr, 0.0);
   ASSERT_EQ(flat.planner_graph(), PlannerGraph::turn_graph);
@@ -327,8 +339,9 @@ TEST(DispatchService, HierarchyAndTurnGraphKeepRoutesOfTheSameCost) {
     EXPECT_NEAR(a.route.travel_time_s, b.route.travel_time_s, 1e-6 * a.route.travel_time_s);
     ids.push_back(a.id);
   }
-  // ambulance and fire engine at 120 km/h, both at 60 km/h: four cost models.
-  EXPECT_EQ(cch.hierarchy()->models_in_use(), 4u);
+  // Ambulance and fire engine at 120 km/h, then the ambulance at 60 km/h; the fire engine at 60 km/h
+  // finds no room.
+  EXPECT_EQ(cch.hierarchy()->models_in_use(), 3u);
 
   const auto same_costs = [&](const std::string& when) {
     for (MissionId id : ids) {
@@ -417,6 +430,9 @@ TEST(DispatchService, AutomaticPlannerGraphKeepsTheTurnGraphWhereTheHierarchyIsD
     c.max_hierarchy_density = bad;
     EXPECT_THROW(DispatchService(grid(), c, nullptr, 0.0), std::invalid_argument) << bad;
   }
+  DispatchConfig no_models;
+  no_models.max_hierarchy_models = 0;
+  EXPECT_THROW(DispatchService(grid(), no_models, nullptr, 0.0), std::invalid_argument);
 }
 
 // An expiry ends only the update it came with: a later closure without expiry stays in force.

@@ -1810,10 +1810,12 @@ export interface components {
             }[];
         };
         CongestionResult: {
+            /** @description Customizing the contraction hierarchy shared by all missions to this batch, once, before their repairs; 0 when missions plan on the turn graph */
+            customization_ms: number;
             edges_changed: number;
             missions_replanned: number;
-            routes_changed: number;
             replan_latency_ms: number;
+            routes_changed: number;
             slowest_replan_ms: number;
         };
         Signal: {
