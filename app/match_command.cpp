@@ -252,7 +252,7 @@ void run_match_bench(const MatchBenchOptions& o) {
     traces.push_back(localizer::make_synthetic_trace(graph, spec));
   }
   std::size_t fixes = 0, correct = 0, nearest_correct = 0, matched = 0;
-  double batch_s = 0.0, online_s = 0.0, sq_err = 0.0, sq_raw = 0.0, sq_nearest = 0.0, length_total = 0.0, length_correct = 0.0;
+  double batch_s = 0.0, online_s = 0.0, sq_err = 0.0, sq_raw = 0.0, sq_nearest = 0.0;
   for (const auto& t : traces) {
     localizer::HmmMatcher batch(graph, snapper);
     auto started = std::chrono::steady_clock::now();
@@ -269,15 +269,10 @@ void run_match_bench(const MatchBenchOptions& o) {
       const auto near = snapper.snap_local(raw);
       nearest_correct += near.edge == t.truth[i] ? 1 : 0;
       sq_nearest += std::pow(maps::distance_m(near.point, t.truth_point[i]), 2);
-      const double weight = 1.0;  // fixes are evenly spaced in distance: by time is by length
-      length_total += weight;
       if (result[i].matched) {
         ++matched;
         sq_err += std::pow(maps::distance_m(result[i].point, t.truth_point[i]), 2);
-        if (result[i].edge == t.truth[i]) {
-          ++correct;
-          length_correct += weight;
-        }
+        if (result[i].edge == t.truth[i]) ++correct;
       }
     }
   }

@@ -81,9 +81,12 @@ void BasicDStarLite<Space>::arcs_changed(std::span<const std::uint32_t> arcs)
 {
   // Near the top of the hierarchy a vertex has hundreds of arcs, and a batch changes many of them:
   // each vertex's rhs is re-derived once, not once per changed arc.
-  std::vector<Vertex> touched;
-  space_.vertices_on_arcs(arcs, touched);
-  for (Vertex u : touched) recompute_rhs(u);
+  // (`if constexpr` as well: clang instantiates this member for SearchSpace too, constraint or not.)
+  if constexpr (std::is_same_v<Space, CchSearchSpace>) {
+    std::vector<Vertex> touched;
+    space_.vertices_on_arcs(arcs, touched);
+    for (Vertex u : touched) recompute_rhs(u);
+  }
 }
 
 template <class Space>
