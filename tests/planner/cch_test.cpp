@@ -16,6 +16,18 @@ namespace {
 
 using testing::random_grid;
 
+// A random grid, its hierarchy, and the metric of the oracle profile at free flow.
+struct GridHierarchy {
+  GridHierarchy(std::uint64_t seed, std::uint32_t rows, std::uint32_t cols)
+      : g(random_grid(seed, rows, cols)), overlay(g), cost(g, overlay, testing::oracle_profile(seed, 25.0)), t(g.turns()),
+        metric(t, cost) {}
+  maps::RoadGraph g;
+  CostOverlay overlay;
+  TravelCost cost;
+  CchTopology t;
+  CchMetric metric;
+};
+
 // The contraction is a chordal supergraph of the turn graph: every turn has an arc, the higher
 // neighbours of a vertex are pairwise joined, and they all lie on its elimination-tree path.
 TEST(CchTopology, ContractionIsChordalAndHoldsEveryTurn) {
@@ -111,11 +123,8 @@ TEST(CchMetric, PartialCustomizationEqualsFullCustomization) {
 
 // A shortcut unpacks into the turns it stands for, and they cost what it weighs.
 TEST(CchMetric, ShortcutsUnpackIntoTurnsOfTheirWeight) {
-  const auto g = random_grid(5, 9, 9);
-  CostOverlay overlay(g);
-  const TravelCost cost(g, overlay, testing::oracle_profile(5, 25.0));
-  const CchTopology t(g.turns());
-  const CchMetric metric(t, cost);
+  const GridHierarchy h(5, 9, 9);
+  const auto& [g, overlay, cost, t, metric] = h;
   int shortcuts = 0;
   std::vector<std::uint32_t> path;
   for (std::uint32_t arc = 0; arc < t.arc_count(); ++arc) {
@@ -144,13 +153,10 @@ TEST(CchMetric, ShortcutsUnpackIntoTurnsOfTheirWeight) {
 
 // A batch of moved arcs names the mission's vertices whose arcs use them, each once: read where
 // the mission's vertices lie when the batch is sorted (as the metric hands it out), arc by arc
-// otherwise, and both agree with asking each arc on its own.
+// otherwise, and both give exactly the vertices whose successor arcs include one of the batch.
 TEST(CchSearchSpace, VerticesOnABatchOfArcsAreEachArcsOnce) {
-  const auto g = random_grid(7, 12, 12);
-  CostOverlay overlay(g);
-  const TravelCost cost(g, overlay, testing::oracle_profile(7, 25.0));
-  const CchTopology t(g.turns());
-  const CchMetric metric(t, cost);
+  const GridHierarchy h(7, 12, 12);
+  const auto& [g, overlay, cost, t, metric] = h;
   std::mt19937 rng(3);
   int found = 0;
   for (int trial = 0; trial < 50; ++trial) {
