@@ -1,5 +1,6 @@
 #include "app/serve_command.hpp"
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <chrono>
@@ -103,6 +104,14 @@ void run_serve(const ServeOptions& o) {
   std::cout << "development token (all roles): " << dev_token << std::endl;
   std::cout << "listening on http://" << host << ":" << http.port() << " (map: " << graph.node_count() << " nodes, "
             << service.active_mission_count() << " active missions resumed, db: " << o.db << ")" << std::endl;
+  // Which graph missions plan on, and for `auto` why: a user sees it without raising the log level.
+  if (const auto* h = service.hierarchy()) {
+    std::cout << fmt::format("planning on a contraction hierarchy shared by all missions ({:.1f} arcs per vertex)",
+                             h->density())
+              << std::endl;
+  } else {
+    std::cout << "planning on the turn graph, each mission its own search" << std::endl;
+  }
   std::cout << "console: open http://" << (host == "0.0.0.0" ? std::string("127.0.0.1") : host) << ":" << http.port()
             << "/ and paste the token above" << std::endl;
   spdlog::info("event=serving address={}:{} threads={}", host, http.port(), o.threads);
