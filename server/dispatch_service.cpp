@@ -87,18 +87,18 @@ DispatchService::DispatchService(const maps::RoadGraph& graph, std::unordered_ma
   if (!(config_.max_hierarchy_density > 0.0)) {
     throw std::invalid_argument("max_hierarchy_density must be positive, not " + std::to_string(config_.max_hierarchy_density));
   }
+  if (config_.max_hierarchy_models < 1) {
+    throw std::invalid_argument("max_hierarchy_models must be at least 1, not " + std::to_string(config_.max_hierarchy_models));
+  }
   if (config_.planner_graph != PlannerGraph::turn_graph) {
+    // `automatic` must build the topology to know its density, and drops it where it is dense.
     const auto started = std::chrono::steady_clock::now();
-    if (config_.max_hierarchy_models < 1) {
-      throw std::invalid_argument("max_hierarchy_models must be at least 1, not " + std::to_string(config_.max_hierarchy_models));
-    }
     hierarchy_ = std::make_unique<SharedHierarchy>(graph, overlay_, config_.max_hierarchy_models);
-    const double took_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-    const bool sparse = hierarchy_->density() <= config_.max_hierarchy_density;
-    spdlog::info("event=planner_graph choice={} arcs={} arcs_per_vertex={:.1f} built_s={:.2f}",
-                 sparse || config_.planner_graph == PlannerGraph::hierarchy ? "hierarchy" : "turn_graph",
-                 hierarchy_->topology().arc_count(), hierarchy_->density(), took_s);
-    if (!sparse && config_.planner_graph == PlannerGraph::automatic) hierarchy_.reset();
+    const bool keep = config_.planner_graph == PlannerGraph::hierarchy || hierarchy_->density() <= config_.max_hierarchy_density;
+    spdlog::info("event=planner_graph choice={} arcs={} arcs_per_vertex={:.1f} built_s={:.2f}", keep ? "hierarchy" : "turn_graph",
+                 hierarchy_->topology().arc_count(), hierarchy_->density(),
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+    if (!keep) hierarchy_.reset();
   }
   for (EdgeId e : graph.edges()) edges_by_way_.emplace(graph.osm_way(e).v, e);
   if (config_.repair_threads > 1) {
@@ -151,38 +151,6 @@ void DispatchService::emit(DispatchEvent event) {
   // Numbered under the lock that orders delivery, so every listener sees seq increasing.
   event.seq = next_event_seq_++;
   for (const auto& [id, l] : listeners_) l(event);
-}
-
-std::string DispatchService::signal_state_locked(NodeId node) const {
-  if (signals_.mode(node) == preemption::SignalMode::held) return "held";
-  // The program passes through yellow and all-red between its own steps too; it is recovering
-  // only on its way back from a hold, until its own phase is on show again.
-  if (!signals_.running_program(node)) {
-    auto it = shown_signal_state_.find(node);
-    if (it != shown_signal_state_.end() && (it->second == "held" || it->second == "recovering")) return "recovering";
-  }
-  if (preemption_.planned(node)) return "scheduled";
-  return "normal";
-}
-
-std::string DispatchService::signal_state(NodeId node) const {
-  if (plans_.count(node) == 0) throw not_found("no signal at node " + std::to_string(node.v));
-  std::lock_guard lock(preemption_mutex_);
-  return signal_state_locked(node);
-}
-
-void DispatchService::announce_signal_state(NodeId node, double now_s) {
-  if (plans_.count(node) == 0) return;
-  std::string state = signal_state_locked(node);
-  auto [it, fresh] = shown_signal_state_.try_emplace(node, "normal");
-  if (it->second == state) return;
-  it->second = state;
-  DispatchEvent e;
-  e.kind = "signal_state";
-  e.signal = node;
-  e.state = std::move(state);
-  e.time_s = now_s;
-  emit(std::move(e));
 }
 
 std::vector<VehicleView> DispatchService::vehicles() const {
@@ -271,23 +239,6 @@ MissionView DispatchService::view(const Mission& m) const {
   v.created_s = m.row.created_s;
   v.updated_s = m.row.updated_s;
   return v;
-}
-
-void DispatchService::drain_preemption_events(Staged& staged) {
-  std::vector<std::pair<NodeId, double>> touched;
-  for (const auto& e : preemption_.take_events()) {
-    stage(staged, [e](Store& store) { store.insert_preemption_event(e); });
-    DispatchEvent out;
-    out.kind = "preemption_" + e.kind;
-    out.mission = e.mission;
-    out.reason = e.detail;
-    out.time_s = e.time_s;
-    out.signal = e.node;
-    emit(std::move(out));
-    touched.emplace_back(e.node, e.time_s);
-  }
-  // The signals these events touched may have changed state; the tick looks at all of them.
-  for (const auto& [node, time_s] : touched) announce_signal_state(node, time_s);
 }
 
 MissionPlanner DispatchService::make_planner(const MissionRow& row, std::vector<planner::EdgePoint> starts,
@@ -631,31 +582,6 @@ PositionResult DispatchService::report_position(const PositionReport& p, double 
   }
   result.durable = submit(staged);
   return result;
-}
-
-void DispatchService::report_counts(NodeId node, maps::Compass approach, double arrivals, double departures, double now_s) {
-  if (plans_.count(node) == 0) throw not_found("no signal at node " + std::to_string(node.v));
-  std::lock_guard lock(preemption_mutex_);
-  try {
-    preemption_.record_counts(node, approach, now_s, arrivals, departures);
-  } catch (const preemption::CountError& e) {
-    throw bad_request(e.what());
-  }
-}
-
-std::vector<preemption::Light> DispatchService::signal_lights(NodeId node) const {
-  if (plans_.count(node) == 0) throw not_found("no signal at node " + std::to_string(node.v));
-  std::lock_guard lock(preemption_mutex_);
-  return signals_.lights(node);
-}
-
-std::pair<std::string, std::size_t> DispatchService::signal_mode(NodeId node) const {
-  if (plans_.count(node) == 0) throw not_found("no signal at node " + std::to_string(node.v));
-  std::lock_guard lock(preemption_mutex_);
-  const char* mode = signals_.mode(node) == preemption::SignalMode::held ? "held"
-                     : signals_.running_program(node)                    ? "program"
-                                                                         : "clearing";
-  return {mode, signals_.program_step(node)};
 }
 
 std::size_t DispatchService::active_mission_count() const {
