@@ -1,7 +1,6 @@
 #include "planner/cch_metric.hpp"
 
 #include <algorithm>
-#include <functional>
 #include <stdexcept>
 #include <string>
 
@@ -14,11 +13,14 @@ CchMetric::CchMetric(const CchTopology& topology, const TravelCost& cost)
       down_(topology.arc_count(), kInfCost),
       via_up_(topology.arc_count(), kNoCchArc),
       via_down_(topology.arc_count(), kNoCchArc),
-      slot_(topology.arc_count(), 0) {
+      slot_(topology.arc_count(), 0),
+      queue_(topology.arc_count()) {
   if (&topology.turns() != &cost.graph().turns()) {
     throw std::invalid_argument("the contraction hierarchy was built for another graph than the cost model's");
   }
-  customize_all();
+  std::vector<std::uint8_t> open = open_inputs();
+  customize_all(open);
+  build_open_lists(open);
 }
 
 double CchMetric::input_s(std::uint32_t index) const {
@@ -30,7 +32,7 @@ double CchMetric::input_s(std::uint32_t index) const {
   return turn >= kInfCost ? kInfCost : add_cost(turn, cost_->transit_s(onto));
 }
 
-void CchMetric::customize_all() {
+void CchMetric::customize_all(std::vector<std::uint8_t>& open) {
   const CchTopology& t = *topology_;
   for (std::uint32_t arc = 0; arc < t.arc_count(); ++arc) {
     const CchTopology::Input& in = t.input(arc);
@@ -38,15 +40,17 @@ void CchMetric::customize_all() {
     down_[arc] = in.down == kNoCchArc ? kInfCost : input_s(in.down);
   }
   // Basic customization: every lower triangle {x, a, b} (x lowest) offers a→x→b and b→x→a. Going
-  // up by x, an arc's weight is final before any arc above it reads it.
+  // up by x, an arc's weight is final before any arc above it reads it. The same sweep opens a→b
+  // where a→x and x→b are open, whatever they weigh today.
   for (std::uint32_t x = 0; x < t.vertex_count(); ++x) {
     const auto ups = t.up(x);
     const std::uint32_t base = t.first_up(x);
     for (std::size_t i = 0; i < ups.size(); ++i) {
       const std::uint32_t xa = base + static_cast<std::uint32_t>(i);
+      if (open[xa] == 0) continue;
       const double a_to_x = down_[xa];
       const double x_to_a = up_[xa];
-      if (a_to_x >= kInfCost && x_to_a >= kInfCost) continue;
+      const bool a_to_x_open = (open[xa] & kDown) != 0, x_to_a_open = (open[xa] & kUp) != 0;
       // The higher neighbours of x above a are higher neighbours of a too (chordality): walk both
       // ascending lists together to find the arcs {a, b}.
       const auto a_ups = t.up(ups[i]);
@@ -55,6 +59,8 @@ void CchMetric::customize_all() {
         while (a_ups[k] < ups[j]) ++k;
         const std::uint32_t ab = t.first_up(ups[i]) + static_cast<std::uint32_t>(k);
         const std::uint32_t xb = base + static_cast<std::uint32_t>(j);
+        if (a_to_x_open && (open[xb] & kUp) != 0) open[ab] |= kUp;    // a→x→b
+        if (x_to_a_open && (open[xb] & kDown) != 0) open[ab] |= kDown;  // b→x→a
         const double up = add_cost(a_to_x, up_[xb]);
         const double down = add_cost(down_[xb], x_to_a);
         if (up < up_[ab]) {
@@ -70,32 +76,104 @@ void CchMetric::customize_all() {
   }
 }
 
-CchMetric::Derived CchMetric::derive(std::uint32_t arc) const {
+std::vector<std::uint8_t> CchMetric::open_inputs() const {
   const CchTopology& t = *topology_;
-  const CchTopology::Input& in = t.input(arc);
-  Derived d{in.up == kNoCchArc ? kInfCost : input_s(in.up), in.down == kNoCchArc ? kInfCost : input_s(in.down),
-            kNoCchArc, kNoCchArc};
+  // An input direction is open unless the profile closes it for good: a restriction or U-turn
+  // rule (turn_s), or an edge the vehicle does not fit. The overlay is not read.
+  const auto input_open = [&](std::uint32_t index) {
+    if (index == kNoCchArc) return false;
+    const maps::TurnArc& a = t.turn_arc(index);
+    return cost_->turn_s(a) < kInfCost && !cost_->blocked(t.turns().edge_of(a.other));
+  };
+  std::vector<std::uint8_t> open(t.arc_count(), 0);
+  for (std::uint32_t arc = 0; arc < t.arc_count(); ++arc) {
+    const CchTopology::Input& in = t.input(arc);
+    open[arc] = static_cast<std::uint8_t>((input_open(in.up) ? kUp : 0) | (input_open(in.down) ? kDown : 0));
+  }
+  return open;
+}
+
+void CchMetric::build_open_lists(const std::vector<std::uint8_t>& open) {
+  const CchTopology& t = *topology_;
+  // The four neighbour lists, by counting. Arc ids ascend by tail and, within a tail, by head, so
+  // filling in id order keeps every list ascending.
+  const std::size_t n = t.vertex_count();
+  for (OpenLists* l : {&lower_out_, &lower_in_, &upper_out_, &upper_in_}) l->first.assign(n + 2, 0);
+  for (std::uint32_t arc = 0; arc < t.arc_count(); ++arc) {
+    const std::uint32_t x = t.tail(arc), y = t.head(arc);
+    if ((open[arc] & kUp) != 0) {  // x→y
+      ++lower_in_.first[y + 2];
+      ++upper_out_.first[x + 2];
+    }
+    if ((open[arc] & kDown) != 0) {  // y→x
+      ++lower_out_.first[y + 2];
+      ++upper_in_.first[x + 2];
+    }
+  }
+  for (OpenLists* l : {&lower_out_, &lower_in_, &upper_out_, &upper_in_}) {
+    for (std::size_t r = 2; r < l->first.size(); ++r) l->first[r] += l->first[r - 1];
+    l->entries.resize(l->first.back());
+  }
+  // first[r + 1] is the next free slot of r's list while filling; afterwards first[r] begins it.
+  const auto put = [](OpenLists& l, std::uint32_t r, std::uint32_t neighbour, std::uint32_t arc) {
+    l.entries[l.first[r + 1]++] = CchDownArc{neighbour, arc};
+  };
+  for (std::uint32_t arc = 0; arc < t.arc_count(); ++arc) {
+    const std::uint32_t x = t.tail(arc), y = t.head(arc);
+    if ((open[arc] & kUp) != 0) {
+      put(lower_in_, y, x, arc);
+      put(upper_out_, x, y, arc);
+    }
+    if ((open[arc] & kDown) != 0) {
+      put(lower_out_, y, x, arc);
+      put(upper_in_, x, y, arc);
+    }
+  }
+  for (OpenLists* l : {&lower_out_, &lower_in_, &upper_out_, &upper_in_}) l->first.pop_back();
+}
+
+namespace {
+
+// The first element at or after `it` whose key is not below `r`: a few steps one by one, where
+// two lists interleave closely, then galloping, where one runs far ahead of the other (a high
+// vertex's lists hold thousands).
+template <typename It, typename Key>
+It skip_below(It it, It end, std::uint32_t r, Key key) {
+  for (int n = 0; n < 4; ++n) {
+    if (it == end || key(*it) >= r) return it;
+    ++it;
+  }
+  std::ptrdiff_t step = 1;
+  while (step < end - it && key(it[step]) < r) step *= 2;
+  return std::lower_bound(it + step / 2, it + std::min(step + 1, end - it), r,
+                          [&](const auto& e, std::uint32_t v) { return key(e) < v; });
+}
+
+std::uint32_t tail_of(const CchDownArc& d) { return d.tail; }
+
+}  // namespace
+
+CchMetric::Derived CchMetric::derive(std::uint32_t arc, bool upward) const {
+  const CchTopology& t = *topology_;
+  const std::uint32_t input = upward ? t.input(arc).up : t.input(arc).down;
+  Derived d{input == kNoCchArc ? kInfCost : input_s(input), kNoCchArc};
   const std::uint32_t x = t.tail(arc), y = t.head(arc);
-  // Lower triangles {z, x, y}: z below x joined to both. Both down lists are sorted by z.
-  const auto dx = t.down(x);
-  const auto dy = t.down(y);
-  auto i = dx.begin();
-  auto j = dy.begin();
-  while (i != dx.end() && j != dy.end() && j->tail < x) {
+  // Lower triangles {z, x, y}, z below x, open the way asked: x→z→y upward, y→z→x downward.
+  // Both lists ascend by z.
+  const auto zx = upward ? lower_out_.of(x) : lower_in_.of(x);
+  const auto zy = upward ? lower_in_.of(y) : lower_out_.of(y);
+  auto i = zx.begin();
+  auto j = zy.begin();
+  while (i != zx.end() && j != zy.end() && j->tail < x) {
     if (i->tail < j->tail) {
-      ++i;
+      i = skip_below(i, zx.end(), j->tail, tail_of);
     } else if (j->tail < i->tail) {
-      ++j;
+      j = skip_below(j, zy.end(), i->tail, tail_of);
     } else {
-      const double up = add_cost(down_[i->arc], up_[j->arc]);
-      const double down = add_cost(down_[j->arc], up_[i->arc]);
-      if (up < d.up) {
-        d.up = up;
-        d.via_up = i->tail;
-      }
-      if (down < d.down) {
-        d.down = down;
-        d.via_down = i->tail;
+      const double w = upward ? add_cost(down_[i->arc], up_[j->arc]) : add_cost(down_[j->arc], up_[i->arc]);
+      if (w < d.weight) {
+        d.weight = w;
+        d.via = i->tail;
       }
       ++i;
       ++j;
@@ -104,7 +182,7 @@ CchMetric::Derived CchMetric::derive(std::uint32_t arc) const {
   return d;
 }
 
-void CchMetric::queue(std::uint32_t arc, bool derive) {
+void CchMetric::queue(std::uint32_t arc, std::uint8_t derive) {
   if (arc == kNoCchArc) return;
   if (slot_[arc] != 0) {
     pending_[slot_[arc] - 1].derive |= derive;
@@ -112,34 +190,38 @@ void CchMetric::queue(std::uint32_t arc, bool derive) {
   }
   pending_.push_back({up_[arc], down_[arc], derive});
   slot_[arc] = static_cast<std::uint32_t>(pending_.size());
-  heap_.push_back(arc);
-  std::push_heap(heap_.begin(), heap_.end(), std::greater<>());
+  queue_.push(arc);
 }
 
 void CchMetric::offer(std::uint32_t arc, bool upward, double old_s, double new_s, std::uint32_t via) {
   const double current = upward ? up_[arc] : down_[arc];
   if (new_s < current) {
-    queue(arc, false);
+    queue(arc, 0);
     (upward ? up_[arc] : down_[arc]) = new_s;
     (upward ? via_up_[arc] : via_down_[arc]) = via;
   } else if (new_s > old_s && old_s == current) {
     // The path through this triangle was (one of) the arc's cheapest and got dearer: only a full
     // look at its triangles tells its new weight.
-    queue(arc, true);
+    queue(arc, upward ? kUp : kDown);
   }
 }
 
+// A turn u→v is the input of arc {u, v} upward when u ranks below v, downward otherwise.
 void CchMetric::queue_turns_into(std::uint32_t v) {
   const CchTopology& t = *topology_;
   for (const maps::TurnArc& a : t.turns().arcs_in(v)) {
-    if (a.other != v) queue(t.find_arc(t.rank(a.other), t.rank(v)));
+    if (a.other == v) continue;
+    const std::uint32_t ru = t.rank(a.other), rv = t.rank(v);
+    queue(t.find_arc(ru, rv), ru < rv ? kUp : kDown);
   }
 }
 
 void CchMetric::queue_turns_out_of(std::uint32_t v) {
   const CchTopology& t = *topology_;
   for (const maps::TurnArc& a : t.turns().arcs_out(v)) {
-    if (a.other != v) queue(t.find_arc(t.rank(v), t.rank(a.other)));
+    if (a.other == v) continue;
+    const std::uint32_t rv = t.rank(v), rw = t.rank(a.other);
+    queue(t.find_arc(rv, rw), rv < rw ? kUp : kDown);
   }
 }
 
@@ -170,54 +252,67 @@ CustomizationStats CchMetric::propagate(std::vector<std::uint32_t>& changed) {
   CustomizationStats stats;
   // An arc's triangles below it have lower ends below its own, so they are settled before it comes
   // off the heap; the writes to it all come from arcs below it, which are settled before it too.
-  while (!heap_.empty()) {
-    std::pop_heap(heap_.begin(), heap_.end(), std::greater<>());
-    const std::uint32_t arc = heap_.back();
-    heap_.pop_back();
+  while (!queue_.empty()) {
+    const std::uint32_t arc = queue_.pop();
     const Pending p = pending_[slot_[arc] - 1];
     slot_[arc] = 0;
-    if (p.derive) {
+    if ((p.derive & kUp) != 0) {
       ++stats.recomputed;
-      const Derived d = derive(arc);
-      up_[arc] = d.up;
-      down_[arc] = d.down;
-      via_up_[arc] = d.via_up;
-      via_down_[arc] = d.via_down;
+      const Derived d = derive(arc, true);
+      up_[arc] = d.weight;
+      via_up_[arc] = d.via;
     }
-    if (up_[arc] == p.old_up && down_[arc] == p.old_down) continue;
+    if ((p.derive & kDown) != 0) {
+      ++stats.recomputed;
+      const Derived d = derive(arc, false);
+      down_[arc] = d.weight;
+      via_down_[arc] = d.via;
+    }
+    const bool up_moved = up_[arc] != p.old_up;      // x→y
+    const bool down_moved = down_[arc] != p.old_down;  // y→x
+    if (!up_moved && !down_moved) continue;
     ++stats.changed;
     changed.push_back(arc);
     // {x, y} is a lower side of every triangle {x, y, z} with z above x; the triangle's arc
-    // between y and z is offered y→x→z and z→x→y.
+    // between y and z is offered y→x→z (riding on y→x) and z→x→y (riding on x→y). Only open
+    // directions x→z and z→x can carry anything.
     const std::uint32_t x = t.tail(arc), y = t.head(arc);
-    // Only a direction that moved has anything to offer: y→x→z rides on y→x, z→x→y on x→y.
-    const bool down_moved = down_[arc] != p.old_down;
-    const bool up_moved = up_[arc] != p.old_up;
-    const auto ups = t.up(x);
     const auto y_ups = t.up(y);
-    std::size_t k = 0;
-    for (std::size_t j = 0; j < ups.size(); ++j) {
-      const std::uint32_t z = ups[j];
-      if (z == y) continue;
-      const std::uint32_t xz = t.first_up(x) + static_cast<std::uint32_t>(j);
-      // A sibling still queued offers its weights as they were when it was queued: its own turn
-      // will offer the step from there to its new weights, so each triangle's sum moves by one
-      // chain of steps that starts at the sum the arc above was derived from.
-      double x_to_z = up_[xz], z_to_x = down_[xz];
-      if (slot_[xz] != 0) {
-        x_to_z = pending_[slot_[xz] - 1].old_up;
-        z_to_x = pending_[slot_[xz] - 1].old_down;
+    const auto y_downs = t.down(y);
+    // The arc between y and z (a neighbour of y by chordality), with z ascending: below y, a
+    // gallop onwards through y's lower list (long, but it stays in cache across the loop); above
+    // y, a walk along its short ascending higher list.
+    const auto between = [&](std::uint32_t z, std::size_t& k, std::size_t& m) {
+      if (z < y) {
+        m = static_cast<std::size_t>(skip_below(y_downs.begin() + static_cast<std::ptrdiff_t>(m), y_downs.end(), z, tail_of) -
+                                     y_downs.begin());
+        return y_downs[m].arc;
       }
-      const bool offer_y_side = down_moved && x_to_z < kInfCost;  // y→x→z
-      const bool offer_z_side = up_moved && z_to_x < kInfCost;    // z→x→y
-      if (z > y) {
-        while (y_ups[k] < z) ++k;  // z is a higher neighbour of y too (chordality)
+      while (y_ups[k] < z) ++k;
+      return t.first_up(y) + static_cast<std::uint32_t>(k);
+    };
+    // A sibling still queued offers its weights as they were when it was queued: its own turn
+    // will offer the step from there to its new weights, so each triangle's sum moves by one
+    // chain of steps that starts at the sum the arc above was derived from.
+    if (down_moved) {
+      std::size_t k = 0, m = 0;
+      for (const CchDownArc& e : upper_out_.of(x)) {
+        const std::uint32_t z = e.tail, xz = e.arc;
+        if (z == y) continue;
+        const double x_to_z = slot_[xz] != 0 ? pending_[slot_[xz] - 1].old_up : up_[xz];
+        if (x_to_z >= kInfCost) continue;
+        offer(between(z, k, m), z > y, add_cost(p.old_down, x_to_z), add_cost(down_[arc], x_to_z), x);
       }
-      if (!offer_y_side && !offer_z_side) continue;
-      const bool y_lower = z > y;
-      const std::uint32_t between = y_lower ? t.first_up(y) + static_cast<std::uint32_t>(k) : t.find_arc(z, y);
-      if (offer_y_side) offer(between, y_lower, add_cost(p.old_down, x_to_z), add_cost(down_[arc], x_to_z), x);
-      if (offer_z_side) offer(between, !y_lower, add_cost(z_to_x, p.old_up), add_cost(z_to_x, up_[arc]), x);
+    }
+    if (up_moved) {
+      std::size_t k = 0, m = 0;
+      for (const CchDownArc& e : upper_in_.of(x)) {
+        const std::uint32_t z = e.tail, xz = e.arc;
+        if (z == y) continue;
+        const double z_to_x = slot_[xz] != 0 ? pending_[slot_[xz] - 1].old_down : down_[xz];
+        if (z_to_x >= kInfCost) continue;
+        offer(between(z, k, m), z < y, add_cost(z_to_x, p.old_up), add_cost(z_to_x, up_[arc]), x);
+      }
     }
   }
   pending_.clear();
@@ -246,10 +341,10 @@ void CchMetric::unpack(std::uint32_t arc, bool upward, std::vector<std::uint32_t
 std::string CchMetric::invariant_violation() const {
   const CchTopology& t = *topology_;
   for (std::uint32_t arc = 0; arc < t.arc_count(); ++arc) {
-    const Derived d = derive(arc);
-    if (d.up != up_[arc] || d.down != down_[arc]) {
+    const double up = derive(arc, true).weight, down = derive(arc, false).weight;
+    if (up != up_[arc] || down != down_[arc]) {
       return "arc " + std::to_string(arc) + " holds " + std::to_string(up_[arc]) + "/" + std::to_string(down_[arc]) +
-             " but its triangles give " + std::to_string(d.up) + "/" + std::to_string(d.down);
+             " but its triangles give " + std::to_string(up) + "/" + std::to_string(down);
     }
     // Each finite weight's witness gives exactly it, so unpacking reproduces the weight.
     const CchTopology::Input& in = t.input(arc);
@@ -278,8 +373,15 @@ std::string CchMetric::invariant_violation() const {
 
 std::size_t CchMetric::memory_bytes() const {
   return (up_.size() + down_.size()) * sizeof(double) +
-         (via_up_.size() + via_down_.size() + slot_.size() + heap_.capacity()) * sizeof(std::uint32_t) +
-         pending_.capacity() * sizeof(Pending);
+         (via_up_.size() + via_down_.size() + slot_.size()) * sizeof(std::uint32_t) + queue_.memory_bytes() +
+         pending_.capacity() * sizeof(Pending) +
+         [&] {
+           std::size_t bytes = 0;
+           for (const OpenLists* l : {&lower_out_, &lower_in_, &upper_out_, &upper_in_}) {
+             bytes += l->first.capacity() * sizeof(std::uint32_t) + l->entries.capacity() * sizeof(CchDownArc);
+           }
+           return bytes;
+         }();
 }
 
 }  // namespace corridor::planner
