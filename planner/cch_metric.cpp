@@ -18,9 +18,9 @@ CchMetric::CchMetric(const CchTopology& topology, const TravelCost& cost)
   if (&topology.turns() != &cost.graph().turns()) {
     throw std::invalid_argument("the contraction hierarchy was built for another graph than the cost model's");
   }
-  std::vector<std::uint8_t> open = open_inputs();
-  customize_all(open);
-  build_open_lists(open);
+  open_ = open_inputs();
+  customize_all(open_);
+  build_open_lists();
 }
 
 double CchMetric::input_s(std::uint32_t index) const {
@@ -93,8 +93,9 @@ std::vector<std::uint8_t> CchMetric::open_inputs() const {
   return open;
 }
 
-void CchMetric::build_open_lists(const std::vector<std::uint8_t>& open) {
+void CchMetric::build_open_lists() {
   const CchTopology& t = *topology_;
+  const std::vector<std::uint8_t>& open = open_;
   // The four neighbour lists, by counting. Arc ids ascend by tail and, within a tail, by head, so
   // filling in id order keeps every list ascending.
   const std::size_t n = t.vertex_count();
@@ -380,7 +381,7 @@ std::size_t CchMetric::memory_bytes() const {
            for (const OpenLists* l : {&lower_out_, &lower_in_, &upper_out_, &upper_in_}) {
              bytes += l->first.capacity() * sizeof(std::uint32_t) + l->entries.capacity() * sizeof(CchDownArc);
            }
-           return bytes;
+           return bytes + open_.capacity();
          }();
 }
 

@@ -38,6 +38,12 @@ class CchMetric {
   [[nodiscard]] double up_s(std::uint32_t arc) const { return up_[arc]; }
   [[nodiscard]] double down_s(std::uint32_t arc) const { return down_[arc]; }
   [[nodiscard]] const CchTopology& topology() const { return *topology_; }
+  // The higher neighbours z of rank r with r→z open (upper_out) or z→r open (upper_in), ascending,
+  // each with the arc's id: the only arcs above r a path of this profile can ever take.
+  [[nodiscard]] std::span<const CchDownArc> upper_out(std::uint32_t r) const { return upper_out_.of(r); }
+  [[nodiscard]] std::span<const CchDownArc> upper_in(std::uint32_t r) const { return upper_in_.of(r); }
+  // Whether arc `arc` is open from its lower end to its higher end (`upward`), or back.
+  [[nodiscard]] bool open(std::uint32_t arc, bool upward) const { return (open_[arc] & (upward ? kUp : kDown)) != 0; }
   [[nodiscard]] const TravelCost& cost() const { return *cost_; }
 
   // The cost overlay behind `cost` changed these edges' conditions or these nodes' delays:
@@ -85,7 +91,7 @@ class CchMetric {
   // Which inputs the profile leaves open (kUp | kDown by arc), and the neighbour lists of the
   // open directions once customize_all has closed them under the triangles.
   [[nodiscard]] std::vector<std::uint8_t> open_inputs() const;
-  void build_open_lists(const std::vector<std::uint8_t>& open);
+  void build_open_lists();
 
   const CchTopology* topology_;
   const TravelCost* cost_;
@@ -106,6 +112,7 @@ class CchMetric {
     }
   };
   OpenLists lower_out_, lower_in_, upper_out_, upper_in_;
+  std::vector<std::uint8_t> open_;  // by arc: kUp | kDown where open
   // One queued arc: its weights before this round, and which directions must be re-derived.
   struct Pending {
     double old_up;

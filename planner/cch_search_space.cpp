@@ -28,24 +28,26 @@ CchSearchSpace::CchSearchSpace(const CchMetric& metric, std::vector<EdgePoint> s
   std::vector<std::uint32_t> from, members;
   for (const Target& t : targets_) from.push_back(t.rank);
   topology_->ancestors(from, members);
-  build_half(std::move(members), down_set_, down_first_, down_arcs_);
+  build_half(std::move(members), false, down_set_, down_first_, down_arcs_);
   from.clear();
   for (const EdgePoint& s : flat_.starts()) from.push_back(topology_->rank(s.vertex()));
   std::sort(from.begin(), from.end());
   start_ranks_ = from;
   topology_->ancestors(from, members);
-  build_half(std::move(members), up_set_, up_first_, up_arcs_);
+  build_half(std::move(members), true, up_set_, up_first_, up_arcs_);
 }
 
-void CchSearchSpace::build_half(std::vector<std::uint32_t> members, std::vector<std::uint32_t>& set,
+void CchSearchSpace::build_half(std::vector<std::uint32_t> members, bool upward, std::vector<std::uint32_t>& set,
                                 std::vector<std::uint32_t>& first, std::vector<CchDownArc>& arcs) const {
   set = std::move(members);
+  const auto open_above = [&](std::uint32_t x) { return upward ? metric_->upper_out(x) : metric_->upper_in(x); };
   // Every higher neighbour of a member is a member (an ancestor of an ancestor). Both lists are
   // ascending, so each neighbour's place in the set is found by galloping on from the last one's.
   std::vector<std::uint32_t> slots;
   for (std::size_t i = 0; i < set.size(); ++i) {
     std::size_t at = i;
-    for (std::uint32_t y : topology_->up(set[i])) {
+    for (const CchDownArc& a : open_above(set[i])) {
+      const std::uint32_t y = a.tail;
       std::size_t step = 1;
       while (at + step < set.size() && set[at + step] < y) step *= 2;
       at = static_cast<std::size_t>(
@@ -62,10 +64,7 @@ void CchSearchSpace::build_half(std::vector<std::uint32_t> members, std::vector<
   std::vector<std::uint32_t> fill(first.begin(), first.end() - 1);
   std::size_t next = 0;
   for (std::uint32_t x : set) {
-    const std::uint32_t base = topology_->first_up(x);
-    for (std::size_t i = 0; i < topology_->up(x).size(); ++i) {
-      arcs[fill[slots[next++]]++] = {x, base + static_cast<std::uint32_t>(i)};
-    }
+    for (const CchDownArc& a : open_above(x)) arcs[fill[slots[next++]]++] = {x, a.arc};
   }
 }
 
@@ -82,7 +81,7 @@ double CchSearchSpace::move_starts(std::vector<EdgePoint> starts) {
   topology_->ancestors(from, members);
   if (members == up_set_) return 0.0;  // along the same edge, or onto one with the same ancestors
   std::vector<std::uint32_t> old_set = std::move(up_set_);
-  build_half(std::move(members), up_set_, up_first_, up_arcs_);
+  build_half(std::move(members), true, up_set_, up_first_, up_arcs_);
   // A vertex that joined or left the upward half gained or lost its upward arcs.
   std::vector<std::uint32_t> moved;
   std::set_symmetric_difference(old_set.begin(), old_set.end(), up_set_.begin(), up_set_.end(), std::back_inserter(moved));
@@ -103,6 +102,7 @@ void CchSearchSpace::vertices_on_arcs(std::span<const std::uint32_t> arcs, std::
         it = std::lower_bound(it, arcs.end(), lo);
         if (it == arcs.end()) return;
         for (; it != arcs.end() && *it < hi; ++it) {
+          if (!metric_->open(*it, upward)) continue;  // not an arc of this half
           out.push_back(Vertex{upward ? x : topology_->head(*it)});
           if (upward) it = std::lower_bound(it, arcs.end(), hi) - 1;  // one of x's arcs is enough
         }

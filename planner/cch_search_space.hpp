@@ -75,8 +75,8 @@ class CchSearchSpace {
   template <class F>
   void for_each_vertex_on_arc(std::uint32_t arc, F&& f) const {
     const std::uint32_t x = topology_->tail(arc);
-    if (in_up(x)) f(Vertex{x});
-    if (in_down(x)) f(Vertex{topology_->head(arc)});
+    if (metric_->open(arc, true) && in_up(x)) f(Vertex{x});
+    if (metric_->open(arc, false) && in_down(x)) f(Vertex{topology_->head(arc)});
   }
   // The same for a batch of arcs, each vertex once, in ascending order, into `out` (cleared). A
   // batch sorted by id (as the metric hands them out) is read only where the mission's vertices'
@@ -97,11 +97,7 @@ class CchSearchSpace {
     if (u == goal()) return;
     const std::uint32_t r = u.v;
     if (in_up(r)) {
-      const auto ups = topology_->up(r);
-      for (std::size_t i = 0; i < ups.size(); ++i) {
-        const std::uint32_t arc = topology_->first_up(r) + static_cast<std::uint32_t>(i);
-        f(Vertex{ups[i]}, metric_->up_s(arc), Via{Via::Kind::up, arc, EdgeId{}});
-      }
+      for (const CchDownArc& a : metric_->upper_out(r)) f(Vertex{a.tail}, metric_->up_s(a.arc), Via{Via::Kind::up, a.arc, EdgeId{}});
     }
     for (const CchDownArc& d : down_out(r)) f(Vertex{d.tail}, metric_->down_s(d.arc), Via{Via::Kind::down, d.arc, EdgeId{}});
     for_each_target_arc(r, [&](double c, EdgeId e) { f(goal(), c, Via{Via::Kind::goal, kNoCchArc, e}); });
@@ -119,10 +115,7 @@ class CchSearchSpace {
     const std::uint32_t r = v.v;
     for (const CchDownArc& d : up_in(r)) f(Vertex{d.tail}, metric_->up_s(d.arc));
     if (in_down(r)) {
-      const auto ups = topology_->up(r);
-      for (std::size_t i = 0; i < ups.size(); ++i) {
-        f(Vertex{ups[i]}, metric_->down_s(topology_->first_up(r) + static_cast<std::uint32_t>(i)));
-      }
+      for (const CchDownArc& a : metric_->upper_in(r)) f(Vertex{a.tail}, metric_->down_s(a.arc));
     }
     for (const EdgePoint& s : starts()) {
       if (topology_->rank(s.vertex()) == r) f(start(), cost().partial_time_s(s.edge, s.offset_m, length_m(s.edge)));
@@ -184,9 +177,9 @@ class CchSearchSpace {
   }
   // Builds a half from its members (the ancestors of its vertices, ascending), filing the arcs
   // between members under their higher end (the upward half enters it by them, the downward half
-  // leaves by them).
-  void build_half(std::vector<std::uint32_t> members, std::vector<std::uint32_t>& set, std::vector<std::uint32_t>& first,
-                  std::vector<CchDownArc>& arcs) const;
+  // leaves by them). Only arcs open in the half's direction are filed.
+  void build_half(std::vector<std::uint32_t> members, bool upward, std::vector<std::uint32_t>& set,
+                  std::vector<std::uint32_t>& first, std::vector<CchDownArc>& arcs) const;
 
   const CchMetric* metric_;
   const CchTopology* topology_;
