@@ -1,6 +1,7 @@
 #include "planner/cch_metric.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <stdexcept>
 #include <string>
 
@@ -252,7 +253,7 @@ CustomizationStats CchMetric::propagate(std::vector<std::uint32_t>& changed) {
   const CchTopology& t = *topology_;
   CustomizationStats stats;
   // An arc's triangles below it have lower ends below its own, so they are settled before it comes
-  // off the heap; the writes to it all come from arcs below it, which are settled before it too.
+  // off the queue; the writes to it all come from arcs below it, which are settled before it too.
   while (!queue_.empty()) {
     const std::uint32_t arc = queue_.pop();
     const Pending p = pending_[slot_[arc] - 1];
@@ -287,6 +288,7 @@ CustomizationStats CchMetric::propagate(std::vector<std::uint32_t>& changed) {
       if (z < y) {
         m = static_cast<std::size_t>(skip_below(y_downs.begin() + static_cast<std::ptrdiff_t>(m), y_downs.end(), z, tail_of) -
                                      y_downs.begin());
+        assert(m < y_downs.size() && y_downs[m].tail == z);
         return y_downs[m].arc;
       }
       while (y_ups[k] < z) ++k;

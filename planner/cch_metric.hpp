@@ -24,7 +24,7 @@
 namespace corridor::planner {
 
 struct CustomizationStats {
-  std::uint64_t recomputed = 0;  // arcs re-derived
+  std::uint64_t recomputed = 0;  // arc directions re-derived
   std::uint64_t changed = 0;     // of those, arcs whose weight moved
 };
 
@@ -39,7 +39,8 @@ class CchMetric {
   [[nodiscard]] double down_s(std::uint32_t arc) const { return down_[arc]; }
   [[nodiscard]] const CchTopology& topology() const { return *topology_; }
   // The higher neighbours z of rank r with r→z open (upper_out) or z→r open (upper_in), ascending,
-  // each with the arc's id: the only arcs above r a path of this profile can ever take.
+  // each with the arc's id: the only arcs above r a path of this profile can ever take. In these
+  // lists CchDownArc::tail holds the neighbour z, the higher end.
   [[nodiscard]] std::span<const CchDownArc> upper_out(std::uint32_t r) const { return upper_out_.of(r); }
   [[nodiscard]] std::span<const CchDownArc> upper_in(std::uint32_t r) const { return upper_in_.of(r); }
   // Whether arc `arc` is open from its lower end to its higher end (`upward`), or back.
@@ -104,6 +105,7 @@ class CchMetric {
   // A vertex's neighbours through open arc directions, each list ascending by neighbour: a CSR
   // per kind, indexed by rank. For a vertex v and a lower neighbour z: lower_out holds z where
   // v→z is open, lower_in where z→v is; upper_out and upper_in the same for higher neighbours.
+  // CchDownArc::tail holds the neighbour, lower or higher.
   struct OpenLists {
     std::vector<std::uint32_t> first;
     std::vector<CchDownArc> entries;  // {neighbour, arc}

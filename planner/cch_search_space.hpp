@@ -8,8 +8,9 @@
 //
 // Vertices are CCH ranks (planner/cch_topology.hpp), then S, then G. The arcs:
 //   S → the start points' vertices (the rest of the start edge), and S → G on one edge;
-//   x → y for every CCH arc with x below y and x an ancestor of a start vertex (weight x→y);
-//   y → x for every CCH arc with x below y and x an ancestor of a goal vertex (weight y→x);
+//   x → y for every CCH arc with x below y, x an ancestor of a start vertex and x→y open for the
+//   profile (planner/cch_metric.hpp; weight x→y);
+//   y → x for every CCH arc with x below y, x an ancestor of a goal vertex and y→x open (weight y→x);
 //   x → G for every turn onto a goal edge from x (the turn, then the goal edge up to the goal).
 // When the vehicle moves, the start's ancestors change: move_starts reports the vertices whose
 // arcs came or went, and D* Lite repairs them like any cost change.

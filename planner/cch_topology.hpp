@@ -19,8 +19,10 @@ namespace corridor::planner {
 
 inline constexpr std::uint32_t kNoCchArc = std::numeric_limits<std::uint32_t>::max();
 
+// A neighbour of a vertex and the arc joining them. In the topology's down lists the neighbour is
+// the arc's lower end (its tail); the metric's open lists reuse it for higher neighbours too.
 struct CchDownArc {
-  std::uint32_t tail;  // the lower rank
+  std::uint32_t tail;  // the neighbour: the lower rank, in down lists
   std::uint32_t arc;   // the arc's id
 };
 

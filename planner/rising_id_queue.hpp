@@ -1,8 +1,10 @@
-// A set of integer ids in [0, n), taken out smallest first, for sweeps that only ever add ids
-// above the one last taken out: the partial customization of a contraction hierarchy, whose
+// A set of integer ids in [0, n), taken out smallest first, built for sweeps that only ever add
+// ids above the one last taken out: the partial customization of a contraction hierarchy, whose
 // writes go from an arc to arcs with higher lower ends (planner/cch_metric.hpp). Two levels of
-// bits: adding is O(1), and a whole sweep scans each summary word at most once, where a binary
-// heap pays a logarithm with scattered reads on every add and every take.
+// bits: adding is O(1), and such a sweep scans each summary word at most once, where a binary
+// heap pays a logarithm with scattered reads on every add and every take. Ids may be added in any
+// order before the first take of a sweep; after it, an id below the last one taken would still
+// come out in order but cost a rescan, so debug builds refuse it.
 #pragma once
 
 #include <bit>
@@ -18,10 +20,10 @@ class RisingIdQueue {
 
   [[nodiscard]] bool empty() const { return size_ == 0; }
 
-  // Adds `id`; a no-op when it is queued. It must not be below the last id taken out in this
-  // sweep (the sweep ends when the queue runs empty).
+  // Adds `id`; a no-op when it is queued. Once this sweep has taken an id out, `id` must be above
+  // it (the sweep ends when the queue runs empty).
   void push(std::uint32_t id) {
-    assert(id / 64 >= cursor_ || size_ == 0);
+    assert(!taking_ || id > last_taken_);
     std::uint64_t& word = bits_[id / 64];
     const std::uint64_t bit = std::uint64_t{1} << (id % 64);
     if ((word & bit) != 0) return;
@@ -45,7 +47,12 @@ class RisingIdQueue {
     word &= word - 1;
     if (word == 0) summary_[s] &= ~(std::uint64_t{1} << (cursor_ % 64));
     --size_;
-    return static_cast<std::uint32_t>(cursor_ * 64 + bit);
+    const auto id = static_cast<std::uint32_t>(cursor_ * 64 + bit);
+#ifndef NDEBUG
+    taking_ = size_ > 0;
+    last_taken_ = id;
+#endif
+    return id;
   }
 
   [[nodiscard]] std::size_t memory_bytes() const { return (bits_.capacity() + summary_.capacity()) * sizeof(std::uint64_t); }
@@ -55,6 +62,10 @@ class RisingIdQueue {
   std::vector<std::uint64_t> summary_;  // one bit per word of bits_: it has a bit set
   std::size_t cursor_ = 0;              // no queued id lies in a word before this one
   std::size_t size_ = 0;
+#ifndef NDEBUG
+  bool taking_ = false;  // a sweep has taken an id out and the queue is not yet empty
+  std::uint32_t last_taken_ = 0;
+#endif
 };
 
 }  // namespace corridor::planner

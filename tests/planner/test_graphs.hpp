@@ -57,6 +57,18 @@ inline maps::RoadGraph with_random_restrictions(const maps::RoadGraph& g, std::u
   return maps::RoadGraph(std::move(d));
 }
 
+// `g` with a 3 m height limit on about one edge in `every` (a fire engine, 3.5 m high, does not
+// fit; an ambulance does).
+inline maps::RoadGraph with_random_height_limits(const maps::RoadGraph& g, std::uint64_t seed, std::uint32_t every) {
+  std::mt19937_64 rng(seed * 7919);
+  maps::RoadGraphData d = g.data();
+  d.edge_limits.clear();
+  for (std::uint32_t e = 0; e < g.edge_count(); ++e) {
+    if (std::uniform_int_distribution<std::uint32_t>(0, every - 1)(rng) == 0) d.edge_limits.push_back({EdgeId{e}, 3.0f, 0.0f, 0.0f});
+  }
+  return maps::RoadGraph(std::move(d));
+}
+
 // The profiles the randomized oracles cycle through: the ambulance, a fire engine, free turns, and
 // U-turns anywhere at a price.
 inline VehicleProfile oracle_profile(std::uint64_t seed, double vmax_mps) {
