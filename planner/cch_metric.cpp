@@ -294,29 +294,25 @@ CustomizationStats CchMetric::propagate(std::vector<std::uint32_t>& changed) {
       while (y_ups[k] < z) ++k;
       return t.first_up(y) + static_cast<std::uint32_t>(k);
     };
-    // A sibling still queued offers its weights as they were when it was queued: its own turn
-    // will offer the step from there to its new weights, so each triangle's sum moves by one
-    // chain of steps that starts at the sum the arc above was derived from.
-    if (down_moved) {
+    // The triangles riding on one direction of {x, y} that moved: y→x→z (on y→x, through open
+    // x→z) `from_y`, z→x→y (on x→y, through open z→x) otherwise.
+    const auto offer_triangles = [&](bool from_y, double old_s, double new_s) {
       std::size_t k = 0, m = 0;
-      for (const CchDownArc& e : upper_out_.of(x)) {
+      for (const CchDownArc& e : from_y ? upper_out_.of(x) : upper_in_.of(x)) {
         const std::uint32_t z = e.tail, xz = e.arc;
         if (z == y) continue;
-        const double x_to_z = slot_[xz] != 0 ? pending_[slot_[xz] - 1].old_up : up_[xz];
-        if (x_to_z >= kInfCost) continue;
-        offer(between(z, k, m), z > y, add_cost(p.old_down, x_to_z), add_cost(down_[arc], x_to_z), x);
+        // A sibling still queued offers its weights as they were when it was queued: its own turn
+        // will offer the step from there to its new weights, so each triangle's sum moves by one
+        // chain of steps that starts at the sum the arc above was derived from.
+        const Pending* queued = slot_[xz] != 0 ? &pending_[slot_[xz] - 1] : nullptr;
+        const double side = from_y ? (queued != nullptr ? queued->old_up : up_[xz])
+                                   : (queued != nullptr ? queued->old_down : down_[xz]);
+        if (side >= kInfCost) continue;
+        offer(between(z, k, m), from_y == (z > y), add_cost(old_s, side), add_cost(new_s, side), x);
       }
-    }
-    if (up_moved) {
-      std::size_t k = 0, m = 0;
-      for (const CchDownArc& e : upper_in_.of(x)) {
-        const std::uint32_t z = e.tail, xz = e.arc;
-        if (z == y) continue;
-        const double z_to_x = slot_[xz] != 0 ? pending_[slot_[xz] - 1].old_down : down_[xz];
-        if (z_to_x >= kInfCost) continue;
-        offer(between(z, k, m), z < y, add_cost(z_to_x, p.old_up), add_cost(z_to_x, up_[arc]), x);
-      }
-    }
+    };
+    if (down_moved) offer_triangles(true, p.old_down, down_[arc]);
+    if (up_moved) offer_triangles(false, p.old_up, up_[arc]);
   }
   pending_.clear();
   return stats;
