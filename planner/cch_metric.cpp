@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "planner/gallop.hpp"
+
 namespace corridor::planner {
 
 CchMetric::CchMetric(const CchTopology& topology, const TravelCost& cost)
@@ -136,21 +138,6 @@ void CchMetric::build_open_lists() {
 
 namespace {
 
-// The first element at or after `it` whose key is not below `r`: a few steps one by one, where
-// two lists interleave closely, then galloping, where one runs far ahead of the other (a high
-// vertex's lists hold thousands).
-template <typename It, typename Key>
-It skip_below(It it, It end, std::uint32_t r, Key key) {
-  for (int n = 0; n < 4; ++n) {
-    if (it == end || key(*it) >= r) return it;
-    ++it;
-  }
-  std::ptrdiff_t step = 1;
-  while (step < end - it && key(it[step]) < r) step *= 2;
-  return std::lower_bound(it + step / 2, it + std::min(step + 1, end - it), r,
-                          [&](const auto& e, std::uint32_t v) { return key(e) < v; });
-}
-
 std::uint32_t tail_of(const CchDownArc& d) { return d.tail; }
 
 }  // namespace
@@ -168,9 +155,9 @@ CchMetric::Derived CchMetric::derive(std::uint32_t arc, bool upward) const {
   auto j = zy.begin();
   while (i != zx.end() && j != zy.end() && j->tail < x) {
     if (i->tail < j->tail) {
-      i = skip_below(i, zx.end(), j->tail, tail_of);
+      i = gallop_to(i, zx.end(), j->tail, tail_of);
     } else if (j->tail < i->tail) {
-      j = skip_below(j, zy.end(), i->tail, tail_of);
+      j = gallop_to(j, zy.end(), i->tail, tail_of);
     } else {
       const double w = upward ? add_cost(down_[i->arc], up_[j->arc]) : add_cost(down_[j->arc], up_[i->arc]);
       if (w < d.weight) {
@@ -286,7 +273,7 @@ CustomizationStats CchMetric::propagate(std::vector<std::uint32_t>& changed) {
     // y, a walk along its short ascending higher list.
     const auto between = [&](std::uint32_t z, std::size_t& k, std::size_t& m) {
       if (z < y) {
-        m = static_cast<std::size_t>(skip_below(y_downs.begin() + static_cast<std::ptrdiff_t>(m), y_downs.end(), z, tail_of) -
+        m = static_cast<std::size_t>(gallop_to(y_downs.begin() + static_cast<std::ptrdiff_t>(m), y_downs.end(), z, tail_of) -
                                      y_downs.begin());
         assert(m < y_downs.size() && y_downs[m].tail == z);
         return y_downs[m].arc;

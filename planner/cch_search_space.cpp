@@ -2,6 +2,8 @@
 
 #include <iterator>
 
+#include "planner/gallop.hpp"
+
 namespace corridor::planner {
 
 CchSearchSpace::CchSearchSpace(const CchMetric& metric, std::vector<EdgePoint> starts, std::vector<EdgePoint> goals)
@@ -45,16 +47,10 @@ void CchSearchSpace::build_half(std::vector<std::uint32_t> members, bool upward,
   // ascending, so each neighbour's place in the set is found by galloping on from the last one's.
   std::vector<std::uint32_t> slots;
   for (std::size_t i = 0; i < set.size(); ++i) {
-    std::size_t at = i;
+    auto at = set.begin() + static_cast<std::ptrdiff_t>(i);
     for (const CchDownArc& a : open_above(set[i])) {
-      const std::uint32_t y = a.tail;
-      std::size_t step = 1;
-      while (at + step < set.size() && set[at + step] < y) step *= 2;
-      at = static_cast<std::size_t>(
-          std::lower_bound(set.begin() + static_cast<std::ptrdiff_t>(at + step / 2),
-                           set.begin() + static_cast<std::ptrdiff_t>(std::min(at + step, set.size() - 1)) + 1, y) -
-          set.begin());
-      slots.push_back(static_cast<std::uint32_t>(at));
+      at = gallop_to(at, set.end(), a.tail, [](std::uint32_t r) { return r; });
+      slots.push_back(static_cast<std::uint32_t>(at - set.begin()));
     }
   }
   first.assign(set.size() + 1, 0);

@@ -247,7 +247,7 @@ MissionPlanner DispatchService::make_planner(const MissionRow& row, std::vector<
   if (hierarchy_) {
     if (auto model = hierarchy_->acquire(profile)) return {std::move(model), std::move(starts), std::move(goals)};
     // Every model the hierarchy may hold is in use by other cost models (each is one more
-    // customization per congestion batch, and 24 bytes per arc): this one plans on the turn graph.
+    // customization per congestion batch, and 46 bytes per arc): this one plans on the turn graph.
     spdlog::info("event=mission_on_turn_graph mission={} reason=hierarchy_models_in_use models={}", row.id,
                  hierarchy_->models_in_use());
   }

@@ -38,7 +38,7 @@ struct HierarchyModel {
 
 class SharedHierarchy {
  public:
-  // Builds the topology (a nested-dissection order and its contraction; 0.5 s on a metro area).
+  // Builds the topology (a nested-dissection order and its contraction; 1.2 s on a metro area).
   // At most `max_models` metrics are kept at once.
   SharedHierarchy(const maps::RoadGraph& graph, const planner::CostOverlay& overlay, std::size_t max_models);
 
