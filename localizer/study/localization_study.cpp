@@ -199,8 +199,13 @@ StudyResult run_localization_study(const maps::RoadGraph& g, const maps::EdgeSna
         const maps::SnapResult near = snapper.snap_local(raw, {500.0});
         d.sq_nearest += std::pow(maps::distance_m(near.point, truth[i]), 2);
         if (hmm_at[i].matched) {
-          d.sq_hmm += std::pow(maps::distance_m(hmm_at[i].point, truth[i]), 2);
+          const double sq = std::pow(maps::distance_m(hmm_at[i].point, truth[i]), 2);
+          d.sq_hmm += sq;
           ++d.n_hmm;
+          if (t.valid()) {
+            d.sq_hmm_on_graph += sq;
+            ++d.n_hmm_on_graph;
+          }
         }
         if (t.valid()) {
           ++d.with_truth;
@@ -258,6 +263,7 @@ StudyResult run_localization_study(const maps::RoadGraph& g, const maps::EdgeSna
     t.length_m += d.length_m;
     t.sq_raw += d.sq_raw, t.sq_nearest += d.sq_nearest, t.sq_hmm += d.sq_hmm, t.sq_fused += d.sq_fused;
     t.n_raw += d.n_raw, t.n_hmm += d.n_hmm, t.n_fused += d.n_fused;
+    t.sq_hmm_on_graph += d.sq_hmm_on_graph, t.n_hmm_on_graph += d.n_hmm_on_graph;
     t.with_truth += d.with_truth;
     t.correct_nearest_road += d.correct_nearest_road, t.correct_hmm += d.correct_hmm;
     t.correct_hmm_road += d.correct_hmm_road, t.correct_fused += d.correct_fused;

@@ -339,5 +339,41 @@ TEST(LocalizationStudy, AJoinedJunctionCountsTheShortEdgesInsideIt) {
   EXPECT_FALSE(truth[0].contains(edge_between(g, {0, 0}, {8, 0})));    // outside it, one edge
 }
 
+// A drive that leaves our graph (SUMO keeps a way our importer drops): its samples there have no
+// true edge, and the on-graph RMSE leaves out the errors no matcher on our graph could avoid.
+TEST(LocalizationStudy, TheOnGraphRmseLeavesOutSamplesOffOurGraph) {
+  Sketch s;
+  // East to (0, 0), then north; from (0, 25) a street runs east, parallel to the drive's line on.
+  s.nodes = {{-600, 0}, {0, 0}, {0, 25}, {0, 300}, {400, 25}};
+  s.roads = {{{0, 1}, false, 1}, {{1, 2, 3}, false, 2}, {{2, 4}, false, 3}};
+  const auto g = s.build();
+  const maps::EdgeSnapper snapper(g);
+  std::vector<TruthSample> drive;
+  for (int k = 0; k <= 60; ++k) {
+    // 10 m/s east along the road, and from x = 0 on straight on, where our graph has no road: the
+    // nearest is the parallel street 25 m away, beyond the truth's radius (20 m).
+    TruthSample t = eastward_sample(g, -400.0 + 10.0 * k, 0.0, "1_0");
+    t.time_s = k;
+    t.speed_mps = 10.0;
+    drive.push_back(t);
+  }
+  StudyConfig config;
+  config.noise_sigma_m = 2.0;
+  config.outlier_share = 0.0;
+  config.outage_s = 0.0;
+  const auto result = run_localization_study(g, snapper, {{"probe", drive}}, config);
+  const DriveResult& d = result.total;
+  EXPECT_EQ(d.n_raw, drive.size());
+  EXPECT_EQ(d.with_truth, 43u);  // x <= 20 m: road 1 within the truth radius
+  ASSERT_GT(d.n_hmm_on_graph, 30u);
+  EXPECT_LT(d.n_hmm_on_graph, d.n_hmm);
+  // Off the road the match is on the parallel street, 25 m away; on it, the error is the noise's,
+  // except where the drive passes the corner (0, 0) and the match has turned already.
+  const double on_graph = std::sqrt(d.sq_hmm_on_graph / static_cast<double>(d.n_hmm_on_graph));
+  const double all = std::sqrt(d.sq_hmm / static_cast<double>(d.n_hmm));
+  EXPECT_GT(all, 10.0);
+  EXPECT_LT(on_graph, 0.6 * all);
+}
+
 }  // namespace
 }  // namespace corridor::localizer
