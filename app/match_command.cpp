@@ -160,7 +160,8 @@ json drive_json(const localizer::DriveResult& d) {
           {"rmse_nearest_m", rmse(d.sq_nearest, d.n_raw)},
           {"rmse_hmm_m", rmse(d.sq_hmm, d.n_hmm)},
           {"hmm_matched_share", ratio(static_cast<double>(d.n_hmm), static_cast<double>(d.n_raw))},
-          // Over the fixes whose true road is in our graph (a share on_graph_share of them).
+          // The HMM's RMSE over its matched fixes that have a true edge; the share of fixes (outside
+          // the outage) with a true edge.
           {"rmse_hmm_on_graph_m", rmse(d.sq_hmm_on_graph, d.n_hmm_on_graph)},
           {"on_graph_share", ratio(truth, static_cast<double>(d.n_raw))},
           {"rmse_fused_m", rmse(d.sq_fused, d.n_fused)},

@@ -38,10 +38,10 @@ struct DriveResult {
   double sq_raw = 0, sq_nearest = 0, sq_hmm = 0, sq_fused = 0;
   std::size_t n_raw = 0, n_hmm = 0, n_fused = 0;
   std::size_t with_truth = 0;
-  // The HMM's squared errors again, over the samples with a true edge only: where no road of our
-  // graph runs the vehicle's way within truth_radius_m, SUMO drives a road our importer leaves
-  // out (a way tagged `construction`, say, which netconvert keeps), and no matcher on our graph
-  // can place the vehicle there.
+  // The HMM's squared errors again, over the samples with a true edge only. A sample has none
+  // where no road of our graph within truth_radius_m runs the vehicle's way: mostly SUMO is then
+  // driving a road our importer leaves out (a way tagged `construction`, which netconvert
+  // keeps), where no matcher on our graph can place the vehicle.
   double sq_hmm_on_graph = 0;
   std::size_t n_hmm_on_graph = 0;
   std::size_t correct_nearest_road = 0, correct_hmm = 0, correct_hmm_road = 0, correct_fused = 0;

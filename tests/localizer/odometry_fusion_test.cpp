@@ -352,7 +352,7 @@ TEST(LocalizationStudy, TheOnGraphRmseLeavesOutSamplesOffOurGraph) {
   for (int k = 0; k <= 60; ++k) {
     // 10 m/s east along the road, and from x = 0 on straight on, where our graph has no road: the
     // nearest is the parallel street 25 m away, beyond the truth's radius (20 m).
-    TruthSample t = eastward_sample(g, -400.0 + 10.0 * k, 0.0, "1_0");
+    TruthSample t = eastward_sample(g, -405.0 + 10.0 * k, 0.0, "1_0");
     t.time_s = k;
     t.speed_mps = 10.0;
     drive.push_back(t);
@@ -364,7 +364,7 @@ TEST(LocalizationStudy, TheOnGraphRmseLeavesOutSamplesOffOurGraph) {
   const auto result = run_localization_study(g, snapper, {{"probe", drive}}, config);
   const DriveResult& d = result.total;
   EXPECT_EQ(d.n_raw, drive.size());
-  EXPECT_EQ(d.with_truth, 43u);  // x <= 20 m: road 1 within the truth radius
+  EXPECT_EQ(d.with_truth, 43u);  // x <= 15 m: the first road within the truth radius (20 m)
   ASSERT_GT(d.n_hmm_on_graph, 30u);
   EXPECT_LT(d.n_hmm_on_graph, d.n_hmm);
   // Off the road the match is on the parallel street, 25 m away; on it, the error is the noise's,
