@@ -30,7 +30,8 @@ struct HmmConfig {
   double max_radius_m = 200.0;
   // Roads per fix (each two-way road gives two directed points). The disc grows to 4σ: at σ 15 m,
   // 60 m, and in an old town more than six roads lie that close, so the driven one could be left
-  // out of a noisy fix's candidates. Ten costs 2 % of batch throughput.
+  // out of a noisy fix's candidates. Ten cost about 3 % of batch throughput
+  // (docs/experiments/localization.md).
   std::size_t max_candidates = 10;
   double beta_m = 6.0;            // transition scale for |network − straight-line| (metres)...
   double beta_per_sigma = 0.7;    // ...at least this × the fix's σ
