@@ -19,10 +19,11 @@ void HmmConfig::validate() const {
   if (!(sigma_base_m > 0.0) || !(default_hdop > 0.0) || !(beta_m > 0.0) || !(min_radius_m > 0.0) ||
       !(max_radius_m >= min_radius_m) || !(max_speed_mps > 0.0) || !(gap_s > 0.0) || !(backward_tolerance_m >= 0.0) || !(backward_sigmas >= 0.0) ||
       !(uturn_penalty >= 0.0) || !(outlier_penalty >= 0.0) || !(heading_sigma_deg > 0.0) ||
+      !(heading_wide_sigma_deg > 0.0) || !(heading_wide_share >= 0.0 && heading_wide_share <= 1.0) ||
       max_candidates == 0 || window == 0 || max_skipped > 16) {
     throw std::invalid_argument(
         "map matcher configuration needs positive scales, radii, speed, gap and window, non-negative penalties, "
-        "and at most 16 fixes set aside in a row");
+        "a wide heading share between 0 and 1, and at most 16 fixes set aside in a row");
   }
 }
 
@@ -37,6 +38,19 @@ HmmMatcher::HmmMatcher(const maps::RoadGraph& graph, const maps::EdgeSnapper& sn
 
 void HmmMatcher::reset() { window_.clear(); }
 
+double HmmMatcher::heading_log_likelihood(double angle_deg) const {
+  // The mixture's log density, summed in the log domain (a narrow σ far out would underflow), over
+  // its value at 0°: a course right along the road costs nothing, as with one Gaussian before.
+  auto log_density = [&](double a) {
+    const double narrow = a / config_.heading_sigma_deg, wide = a / config_.heading_wide_sigma_deg;
+    const double ln = std::log((1.0 - config_.heading_wide_share) / config_.heading_sigma_deg) - 0.5 * narrow * narrow;
+    const double lw = std::log(config_.heading_wide_share / config_.heading_wide_sigma_deg) - 0.5 * wide * wide;
+    const double top = std::max(ln, lw);
+    return top + std::log(std::exp(ln - top) + std::exp(lw - top));
+  };
+  return log_density(angle_deg) - log_density(0.0);
+}
+
 std::vector<HmmMatcher::Candidate> HmmMatcher::candidates_for(const GpsFix& fix, maps::Point2 raw) const {
   const double hdop = usable_hdop(fix, config_.default_hdop);
   const double sigma = hdop * config_.sigma_base_m;
@@ -50,8 +64,7 @@ std::vector<HmmMatcher::Candidate> HmmMatcher::candidates_for(const GpsFix& fix,
     auto add = [&](EdgeId e, double offset) {
       double score = emission;
       if (use_heading) {
-        const double off = angle_between_deg(road_bearing_deg(graph_, e, offset), *fix.heading_deg) / config_.heading_sigma_deg;
-        score -= 0.5 * off * off;
+        score += heading_log_likelihood(angle_between_deg(road_bearing_deg(graph_, e, offset), *fix.heading_deg));
       }
       out.push_back({e, offset, road.point, road.distance_m, score, -1});
     };

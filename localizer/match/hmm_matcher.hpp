@@ -37,7 +37,17 @@ struct HmmConfig {
   double beta_per_sigma = 0.7;    // ...at least this × the fix's σ
   double max_speed_mps = 70.0;    // a move needing more is impossible
   double gap_s = 60.0;            // fixes further apart in time break the chain
-  double heading_sigma_deg = 40.0;
+  // The course over ground of a moving fix, against the road's bearing: a mixture of two
+  // Gaussians. Along a road the course follows its bearing to within the receiver's course error,
+  // a lane change and the road's drawing (heading_sigma_deg); through a junction's turn, or where
+  // a road is drawn coarsely, it sweeps far from it (heading_wide_sigma_deg, a share
+  // heading_wide_share of the fixes). One Gaussian wide enough for the turns (40°, the model
+  // until session 9) tells a road from a neighbour 30° off by only 0.3 (log-likelihood); one
+  // narrow enough for that would price every turn as an error. docs/experiments/localization.md
+  // gives what the mixture moved, on drives it was not chosen on as well.
+  double heading_sigma_deg = 10.0;
+  double heading_wide_sigma_deg = 40.0;
+  double heading_wide_share = 0.2;
   double heading_min_speed_mps = 2.0;  // below this the course over ground is noise
   // Noise may put a fix a little behind the last one on the same road: up to the larger of these
   // is read as standing or creeping, not as a drive round the block. Two fixes' positions along a
@@ -108,6 +118,9 @@ class HmmMatcher {
     double norm = 0.0;
   };
 
+  // The heading term of the emission (log-likelihood, 0 at 0°) for an angle between the fix's
+  // course and the road's bearing.
+  [[nodiscard]] double heading_log_likelihood(double angle_deg) const;
   // Candidates of a fix with their emission scores.
   std::vector<Candidate> candidates_for(const GpsFix& fix, maps::Point2 raw) const;
   // The best move found so far into each candidate of a step, and the nodes the moves' searches

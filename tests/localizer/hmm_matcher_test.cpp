@@ -271,6 +271,45 @@ TEST(HmmMatcher, AVehicleWaitingAtAJunctionStaysOnItsApproach) {
   EXPECT_GE(online_on, 15 + 40);
 }
 
+// A fork: the trunk runs east, then road 2 goes on east and road 3 leaves 20° to its left. The
+// vehicle keeps east on road 2, its course saying so, while its fixes (σ 12 m) drift north, four
+// fifths of the way towards road 3 and so nearer to it, for the 75 m after the fork. Both roads
+// lead on from the fork and the moves fit either, so only the course tells them apart. In the
+// heading mixture 20° off a road costs 1.7 (log-likelihood), more than the up to 1.6 that a fix's
+// distances give road 3; one Gaussian wide enough for turns (σ 40°) charges 0.1, so it follows
+// the fixes onto the wrong branch, which is what this case is for.
+TEST(HmmMatcher, TheCourseTellsTheBranchesOfAShallowForkApart) {
+  Sketch s;
+  const double fork_deg = 20.0, rad = fork_deg * std::numbers::pi / 180.0;
+  s.nodes = {{0, 0}, {300, 0}, {800, 0}, {300 + 500 * std::cos(rad), 500 * std::sin(rad)}};
+  s.roads = {{{0, 1}, false, 1}, {{1, 2}, false, 2}, {{1, 3}, false, 3}};
+  const auto g = s.build();
+  const maps::EdgeSnapper snapper(g);
+  std::vector<GpsFix> trace;
+  for (int i = 0; i <= 19; ++i) {
+    const double x = 90.0 + 15.0 * i, past = std::max(0.0, x - 300.0);
+    GpsFix f = fix_at(g, i, {x, 0.8 * past * std::tan(rad)}, 90.0, 15.0);
+    f.hdop = 3.0;
+    trace.push_back(f);
+  }
+  auto on_road_2_after_the_fork = [&](const std::vector<MatchedPoint>& matched, const char* how) {
+    for (std::size_t i = 0; i < trace.size(); ++i) {
+      if (g.projection().to_local(trace[i].position).x_m < 330.0) continue;  // the fork's first 30 m may go either way
+      EXPECT_EQ(way_of(g, matched[i]), 2) << how << " fix " << i;
+    }
+  };
+  HmmMatcher batch(g, snapper);
+  on_road_2_after_the_fork(batch.match(trace), "batch");
+  HmmMatcher online(g, snapper);
+  std::vector<MatchedPoint> live;
+  for (const GpsFix& f : trace) live.push_back(online.update(f));
+  on_road_2_after_the_fork(live, "online");
+  // The case is hard for a single wide Gaussian in the course.
+  HmmMatcher wide(g, snapper, HmmConfig{.heading_sigma_deg = 40.0, .heading_wide_share = 0.0});
+  EXPECT_EQ(way_of(g, wide.match(trace).back()), 3);
+  EXPECT_THROW(HmmMatcher(g, snapper, HmmConfig{.heading_wide_share = 1.5}), std::invalid_argument);
+}
+
 TEST(HmmMatcher, RejectsUnsortedTimesAndNonFiniteFixes) {
   Sketch s;
   s.nodes = {{0, 0}, {500, 0}};
