@@ -19,11 +19,12 @@ void HmmConfig::validate() const {
   if (!(sigma_base_m > 0.0) || !(default_hdop > 0.0) || !(beta_m > 0.0) || !(min_radius_m > 0.0) ||
       !(max_radius_m >= min_radius_m) || !(max_speed_mps > 0.0) || !(gap_s > 0.0) || !(backward_tolerance_m >= 0.0) || !(backward_sigmas >= 0.0) ||
       !(uturn_penalty >= 0.0) || !(outlier_penalty >= 0.0) || !(heading_sigma_deg > 0.0) ||
-      !(heading_wide_sigma_deg > 0.0) || !(heading_wide_share >= 0.0 && heading_wide_share <= 1.0) ||
+      !std::isfinite(heading_sigma_deg) || !(heading_wide_sigma_deg > 0.0) || !std::isfinite(heading_wide_sigma_deg) ||
+      !(heading_wide_share >= 0.0 && heading_wide_share <= 1.0) ||
       max_candidates == 0 || window == 0 || max_skipped > 16) {
     throw std::invalid_argument(
         "map matcher configuration needs positive scales, radii, speed, gap and window, non-negative penalties, "
-        "a wide heading share between 0 and 1, and at most 16 fixes set aside in a row");
+        "finite heading sigmas, a wide heading share between 0 and 1, and at most 16 fixes set aside in a row");
   }
 }
 
@@ -39,8 +40,9 @@ HmmMatcher::HmmMatcher(const maps::RoadGraph& graph, const maps::EdgeSnapper& sn
 void HmmMatcher::reset() { window_.clear(); }
 
 double HmmMatcher::heading_log_likelihood(double angle_deg) const {
-  // The mixture's log density, summed in the log domain (a narrow σ far out would underflow), over
-  // its value at 0°: a course right along the road costs nothing, as with one Gaussian before.
+  // The mixture's log density, summed in the log domain (a σ of a few degrees would underflow
+  // exp() at 180°), over its value at 0°: a course right along the road costs nothing, as with one
+  // Gaussian before. Both σ are finite (validate), so one part is always finite.
   auto log_density = [&](double a) {
     const double narrow = a / config_.heading_sigma_deg, wide = a / config_.heading_wide_sigma_deg;
     const double ln = std::log((1.0 - config_.heading_wide_share) / config_.heading_sigma_deg) - 0.5 * narrow * narrow;

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <iostream>
+#include <limits>
 #include <numbers>
 #include <random>
 #include <string>
@@ -294,7 +295,7 @@ TEST(HmmMatcher, TheCourseTellsTheBranchesOfAShallowForkApart) {
   }
   auto on_road_2_after_the_fork = [&](const std::vector<MatchedPoint>& matched, const char* how) {
     for (std::size_t i = 0; i < trace.size(); ++i) {
-      if (g.projection().to_local(trace[i].position).x_m < 330.0) continue;  // the fork's first 30 m may go either way
+      if (g.projection().to_local(trace[i].position).x_m < 322.5) continue;  // the fork's first 30 m may go either way
       EXPECT_EQ(way_of(g, matched[i]), 2) << how << " fix " << i;
     }
   };
@@ -306,8 +307,14 @@ TEST(HmmMatcher, TheCourseTellsTheBranchesOfAShallowForkApart) {
   on_road_2_after_the_fork(live, "online");
   // The case is hard for a single wide Gaussian in the course.
   HmmMatcher wide(g, snapper, HmmConfig{.heading_sigma_deg = 40.0, .heading_wide_share = 0.0});
-  EXPECT_EQ(way_of(g, wide.match(trace).back()), 3);
+  const auto by_wide = wide.match(trace);
+  for (std::size_t i = 17; i < trace.size(); ++i) EXPECT_EQ(way_of(g, by_wide[i]), 3) << "single Gaussian, fix " << i;
+  // All the weight on the wide part is the same single Gaussian.
+  HmmMatcher all_wide(g, snapper, HmmConfig{.heading_wide_share = 1.0});
+  EXPECT_EQ(way_of(g, all_wide.match(trace).back()), 3);
   EXPECT_THROW(HmmMatcher(g, snapper, HmmConfig{.heading_wide_share = 1.5}), std::invalid_argument);
+  EXPECT_THROW(HmmMatcher(g, snapper, HmmConfig{.heading_sigma_deg = std::numeric_limits<double>::infinity()}),
+               std::invalid_argument);
 }
 
 TEST(HmmMatcher, RejectsUnsortedTimesAndNonFiniteFixes) {
