@@ -118,6 +118,13 @@ void OdometryMapMatcher::move(Hypothesis h, double left_m, std::vector<Hypothesi
       continue;
     }
     const double rest = f.left - (len - f.h.offset_m);
+    if (slow_ && rest < config_.junction_commit_m) {  // slow, and not yet clearly past the node
+      f.h.offset_m = len;
+      f.h.past_node_m = rest;
+      out.push_back(f.h);
+      continue;
+    }
+    f.h.past_node_m = 0.0;
     const NodeId junction = graph_.head(f.h.edge);
     const EdgeId back = graph_.twin(f.h.edge);
     const double bearing_in = road_bearing_deg(f.h.edge, len);
@@ -152,7 +159,9 @@ void OdometryMapMatcher::drive(double distance_m, double turn_deg) {
     // Dead reckoning at the step's mean heading, in this hypothesis's frame (x east, y north).
     const double mid = (heading_deg_ - turn_deg / 2.0 + h.heading_bias_deg) * kDegToRad;
     h.reckoned = {h.reckoned.x_m + distance_m * std::sin(mid), h.reckoned.y_m + distance_m * std::cos(mid)};
-    move(h, distance_m, scratch_);
+    const double left = distance_m + h.past_node_m;
+    h.past_node_m = 0.0;
+    move(h, left, scratch_);
   }
   hyps_.swap(scratch_);
 }
@@ -266,6 +275,7 @@ bool OdometryMapMatcher::add_siblings() {
     for (const double shift : {-config_.sibling_step_m, config_.sibling_step_m}) {
       Hypothesis h = hyps_[i];
       h.offset_m += shift;
+      h.past_node_m = 0.0;
       if (h.offset_m < 0.0 || h.offset_m > graph_.length_m(h.edge)) continue;
       h.cost += config_.sibling_cost;
       hyps_.push_back(h);
@@ -315,6 +325,8 @@ MatchedPoint OdometryMapMatcher::advance(const OdometryStep& step) {
   heading_deg_ = wrap180(heading_deg_ + turn);
   driven_m_ += dist;
   const double time_s = std::isfinite(step.time_s) ? step.time_s : headings_.back().first;
+  const double dt = headings_.empty() ? 0.0 : time_s - headings_.back().first;
+  slow_ = dt > 0.0 && dist < config_.slow_speed_mps * dt;
   headings_.emplace_back(time_s, heading_deg_);
   while (headings_.size() > kMaxHistory || (headings_.size() > 1 && headings_.front().first < time_s - config_.heading_window_s)) {
     headings_.pop_front();

@@ -71,6 +71,14 @@ struct OdometryMatchConfig {
   double sibling_cost = 1.0;
   std::size_t sibling_parents = 3;
   double merge_m = 2.0;              // two hypotheses this close on one edge are one
+  // A slow vehicle (odometry under slow_speed_mps: slowing for a junction, or stopping) takes a
+  // junction's exits only once it is junction_commit_m past the node; until then it waits at its
+  // approach's end, the distance carried, not lost. Stopped at a stop line right by the node, a
+  // few decimetres of drift would otherwise put it on an exit, past the signal it is waiting at.
+  // A faster vehicle commits at once: holding it back makes it lag at every junction (measured:
+  // docs/experiments/localization.md).
+  double junction_commit_m = 2.0;
+  double slow_speed_mps = 4.0;
 };
 
 // Where the odometry starts: the last good fix, matched.
@@ -131,6 +139,9 @@ class OdometryMapMatcher {
     double sharp_s = -1e18;
     double sharp_turn_deg = 0;
     bool sharp_pending = false;
+    // Waiting at its approach's end: how far past the node the odometry has carried it while
+    // slow (added to the next move).
+    double past_node_m = 0;
   };
   struct Pending {
     OdometryStep step;
@@ -158,6 +169,7 @@ class OdometryMapMatcher {
   std::vector<Hypothesis> hyps_;
   std::vector<Hypothesis> scratch_;
   bool seeded_ = false;
+  bool slow_ = false;       // the last increment was slower than slow_speed_mps
   double heading_deg_ = 0;  // integrated odometry heading from the start's (a hypothesis adds its bias)
   double driven_m_ = 0;     // since the start
   double siblings_at_m_ = 0;

@@ -87,6 +87,35 @@ TEST(OdometryMapMatcher, TakesTheExitItsHeadingTurnedToAndResetsTheDrift) {
   EXPECT_LT(left.sigma_m(), 5.0);
 }
 
+// Eastbound towards the crossroads, the vehicle slows to a stop that the odometry puts 0.2 m past
+// the node (its front is at the stop line, right by the node in the map). It must stay on its
+// approach while it waits, not be reported on an exit past the junction it waits at. When it
+// drives on, it takes the exit with the distance it was held back carried, not lost.
+TEST(OdometryMapMatcher, AVehicleStoppingRightAtTheNodeWaitsOnItsApproach) {
+  const auto g = crossroads();
+  const EdgeId west_in = edge_between(g, {-300, 0}, {0, 0}), east_out = edge_between(g, {0, 0}, {300, 0});
+  OdometryMapMatcher m(g);
+  m.start(west_in, 250.0, 90.0, 0.0, 5.0);
+  double t = 0.0;
+  MatchedPoint p;
+  for (const double d : {8.0, 8.0, 8.0, 8.0, 8.0, 5.0, 3.0, 1.5, 0.7}) p = m.advance({t += 1.0, d, 0.0});
+  for (int i = 0; i < 30; ++i) {
+    p = m.advance({t += 1.0, 0.0, 0.0});
+    ASSERT_EQ(p.edge, west_in) << "standing, second " << i;
+    EXPECT_NEAR(p.offset_m, 300.0, 1e-9);
+  }
+  p = m.advance({t += 1.0, 10.0, 0.0});
+  EXPECT_EQ(p.edge, east_out);
+  EXPECT_NEAR(p.offset_m, 10.2, 0.01);
+  // A vehicle that passes the node at speed is not held back, however little of the step is left.
+  OdometryMapMatcher fast(g);
+  fast.start(west_in, 270.5, 90.0, 0.0, 5.0);
+  t = 0.0;
+  for (int i = 0; i < 3; ++i) p = fast.advance({t += 1.0, 10.0, 0.0});
+  EXPECT_EQ(p.edge, east_out);
+  EXPECT_NEAR(p.offset_m, 0.5, 0.01);
+}
+
 TEST(OdometryMapMatcher, AHeadingThatDisagreesWithTheRoadRaisesTheUncertainty) {
   const auto g = crossroads();
   OdometryMapMatcher m(g);
