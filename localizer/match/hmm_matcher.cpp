@@ -35,6 +35,9 @@ HmmMatcher::HmmMatcher(const maps::RoadGraph& graph, const maps::EdgeSnapper& sn
       config_(config),
       distances_(arrays == SearchArrays::owned ? std::make_unique<planner::BoundedDistances>(graph.node_count()) : nullptr) {
   config_.validate();
+  heading_log_narrow_ = std::log((1.0 - config_.heading_wide_share) / config_.heading_sigma_deg);
+  heading_log_wide_ = std::log(config_.heading_wide_share / config_.heading_wide_sigma_deg);
+  heading_log_at_zero_ = heading_log_likelihood(0.0);  // with the member still 0: the raw density
 }
 
 void HmmMatcher::reset() { window_.clear(); }
@@ -43,14 +46,11 @@ double HmmMatcher::heading_log_likelihood(double angle_deg) const {
   // The mixture's log density, summed in the log domain (a σ of a few degrees would underflow
   // exp() at 180°), over its value at 0°: a course right along the road costs nothing, as with one
   // Gaussian before. Both σ are finite (validate), so one part is always finite.
-  auto log_density = [&](double a) {
-    const double narrow = a / config_.heading_sigma_deg, wide = a / config_.heading_wide_sigma_deg;
-    const double ln = std::log((1.0 - config_.heading_wide_share) / config_.heading_sigma_deg) - 0.5 * narrow * narrow;
-    const double lw = std::log(config_.heading_wide_share / config_.heading_wide_sigma_deg) - 0.5 * wide * wide;
-    const double top = std::max(ln, lw);
-    return top + std::log(std::exp(ln - top) + std::exp(lw - top));
-  };
-  return log_density(angle_deg) - log_density(0.0);
+  const double narrow = angle_deg / config_.heading_sigma_deg, wide = angle_deg / config_.heading_wide_sigma_deg;
+  const double ln = heading_log_narrow_ - 0.5 * narrow * narrow;
+  const double lw = heading_log_wide_ - 0.5 * wide * wide;
+  const double top = std::max(ln, lw);
+  return top + std::log(std::exp(ln - top) + std::exp(lw - top)) - heading_log_at_zero_;
 }
 
 std::vector<HmmMatcher::Candidate> HmmMatcher::candidates_for(const GpsFix& fix, maps::Point2 raw) const {

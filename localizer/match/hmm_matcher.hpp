@@ -149,6 +149,9 @@ class HmmMatcher {
   const maps::EdgeSnapper& snapper_;
   HmmConfig config_;
   std::unique_ptr<planner::BoundedDistances> distances_;  // null when lent
+  // The heading mixture's parts' log weights (log(share / σ)) and its log density at 0°, fixed by
+  // the configuration: worked out once, not for every candidate.
+  double heading_log_narrow_ = 0, heading_log_wide_ = 0, heading_log_at_zero_ = 0;
   std::deque<Step> window_;
 };
 
