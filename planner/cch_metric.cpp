@@ -9,9 +9,10 @@
 
 namespace corridor::planner {
 
-CchMetric::CchMetric(const CchTopology& topology, const TravelCost& cost)
+CchMetric::CchMetric(const CchTopology& topology, const TravelCost& cost, CchMetricOptions options)
     : topology_(&topology),
       cost_(&cost),
+      options_(options),
       up_(topology.arc_count(), kInfCost),
       down_(topology.arc_count(), kInfCost),
       via_up_(topology.arc_count(), kNoCchArc),
@@ -24,6 +25,23 @@ CchMetric::CchMetric(const CchTopology& topology, const TravelCost& cost)
   open_ = open_inputs();
   customize_all(open_);
   build_open_lists();
+  if (options_.lazy_rises) {
+    // Every weight of a full customization is exact: found so in batch 1, before any change.
+    changed_below_.assign(topology.vertex_count(), 0);
+    parent_.resize(topology.vertex_count());
+    for (std::uint32_t r = 0; r < topology.vertex_count(); ++r) parent_[r] = topology.parent(r);
+    exact_up_.assign(topology.arc_count(), batch_);
+    exact_down_.assign(topology.arc_count(), batch_);
+  }
+}
+
+void CchMetric::mark_changed(std::uint32_t arc) {
+  if (!options_.lazy_rises || arc == kNoCchArc) return;
+  // The arc's lower end and its ancestors: every subtree that holds this input. A vertex already
+  // marked in this batch has its ancestors marked too.
+  for (std::uint32_t r = topology_->tail(arc); r != kNoCchArc && changed_below_[r] != batch_; r = parent_[r]) {
+    changed_below_[r] = batch_;
+  }
 }
 
 double CchMetric::input_s(std::uint32_t index) const {
@@ -188,7 +206,7 @@ void CchMetric::offer(std::uint32_t arc, bool upward, double old_s, double new_s
     queue(arc, 0);
     (upward ? up_[arc] : down_[arc]) = new_s;
     (upward ? via_up_[arc] : via_down_[arc]) = via;
-  } else if (new_s > old_s && old_s == current) {
+  } else if (!options_.lazy_rises && new_s > old_s && old_s == current) {
     // The path through this triangle was (one of) the arc's cheapest and got dearer: only a full
     // look at its triangles tells its new weight.
     queue(arc, upward ? kUp : kDown);
@@ -201,7 +219,9 @@ void CchMetric::queue_turns_into(std::uint32_t v) {
   for (const maps::TurnArc& a : t.turns().arcs_in(v)) {
     if (a.other == v) continue;
     const std::uint32_t ru = t.rank(a.other), rv = t.rank(v);
-    queue(t.find_arc(ru, rv), ru < rv ? kUp : kDown);
+    const std::uint32_t arc = t.find_arc(ru, rv);
+    mark_changed(arc);
+    queue(arc, ru < rv ? kUp : kDown);
   }
 }
 
@@ -210,13 +230,16 @@ void CchMetric::queue_turns_out_of(std::uint32_t v) {
   for (const maps::TurnArc& a : t.turns().arcs_out(v)) {
     if (a.other == v) continue;
     const std::uint32_t rv = t.rank(v), rw = t.rank(a.other);
-    queue(t.find_arc(rv, rw), rv < rw ? kUp : kDown);
+    const std::uint32_t arc = t.find_arc(rv, rw);
+    mark_changed(arc);
+    queue(arc, rv < rw ? kUp : kDown);
   }
 }
 
 CustomizationStats CchMetric::edges_changed(std::span<const EdgeId> edges, std::vector<std::uint32_t>& changed) {
   // An edge's conditions enter every turn onto it (the turn's input cost drives the edge), and the
   // turns onto its via-way copies.
+  ++batch_;
   for (EdgeId e : edges) {
     queue_turns_into(e.v);
     for (std::uint32_t c : topology_->turns().copies_of(e)) queue_turns_into(c);
@@ -227,6 +250,7 @@ CustomizationStats CchMetric::edges_changed(std::span<const EdgeId> edges, std::
 CustomizationStats CchMetric::nodes_changed(std::span<const NodeId> nodes, std::vector<std::uint32_t>& changed) {
   // A node's delay enters every turn made at it: the turns out of the vertices standing there.
   const maps::RoadGraph& g = cost_->graph();
+  ++batch_;
   for (NodeId n : nodes) {
     for (EdgeId e : g.in_edges(n)) {
       queue_turns_out_of(e.v);
@@ -245,17 +269,24 @@ CustomizationStats CchMetric::propagate(std::vector<std::uint32_t>& changed) {
     const std::uint32_t arc = queue_.pop();
     const Pending p = pending_[slot_[arc] - 1];
     slot_[arc] = 0;
-    if ((p.derive & kUp) != 0) {
+    for (const bool upward : {true, false}) {
+      if ((p.derive & (upward ? kUp : kDown)) == 0) continue;
       ++stats.recomputed;
-      const Derived d = derive(arc, true);
-      up_[arc] = d.weight;
-      via_up_[arc] = d.via;
-    }
-    if ((p.derive & kDown) != 0) {
-      ++stats.recomputed;
-      const Derived d = derive(arc, false);
-      down_[arc] = d.weight;
-      via_down_[arc] = d.via;
+      double& w = upward ? up_[arc] : down_[arc];
+      std::uint32_t& via = upward ? via_up_[arc] : via_down_[arc];
+      if (options_.lazy_rises) {
+        // Only a cheaper input can move a lower bound down; a dearer one waits for settle().
+        const std::uint32_t input = upward ? t.input(arc).up : t.input(arc).down;
+        const double in = input == kNoCchArc ? kInfCost : input_s(input);
+        if (in < w) {
+          w = in;
+          via = kNoCchArc;
+        }
+      } else {
+        const Derived d = derive(arc, upward);
+        w = d.weight;
+        via = d.via;
+      }
     }
     const bool up_moved = up_[arc] != p.old_up;      // x→y
     const bool down_moved = down_[arc] != p.old_down;  // y→x
@@ -324,10 +355,51 @@ void CchMetric::unpack(std::uint32_t arc, bool upward, std::vector<std::uint32_t
   }
 }
 
+double CchMetric::settle(std::uint32_t arc, bool upward, std::vector<std::uint32_t>& raised) {
+  if (!options_.lazy_rises) return upward ? up_[arc] : down_[arc];
+  const CchTopology& t = *topology_;
+  // Every weight is at most its triangles' sums and its input (they only rise between settles),
+  // and so at most its true value. Each round either ends or moves the witness to another triangle
+  // of lower-bound sum; sums only rise as witnesses settle, so the rounds end.
+  std::uint32_t& exact = upward ? exact_up_[arc] : exact_down_[arc];
+  if (exact >= changed_below_[t.tail(arc)]) return upward ? up_[arc] : down_[arc];
+  for (;;) {
+    const std::uint32_t z = upward ? via_up_[arc] : via_down_[arc];
+    double witnessed = kInfCost;
+    if (z == kNoCchArc) {
+      const std::uint32_t input = upward ? t.input(arc).up : t.input(arc).down;
+      if (input != kNoCchArc) witnessed = input_s(input);
+    } else {
+      // x→z→y upward, y→z→x downward, z below both (as unpack follows them).
+      const std::uint32_t zx = t.find_arc(z, t.tail(arc)), zy = t.find_arc(z, t.head(arc));
+      witnessed = upward ? add_cost(settle(zx, false, raised), settle(zy, true, raised))
+                         : add_cost(settle(zy, false, raised), settle(zx, true, raised));
+    }
+    double& w = upward ? up_[arc] : down_[arc];
+    if (witnessed == w) break;
+    const Derived d = derive(arc, upward);
+    assert(d.weight >= w);
+    w = d.weight;
+    (upward ? via_up_[arc] : via_down_[arc]) = d.via;
+    raised.push_back(arc);
+    if (d.via == z) break;  // the same witness, now settled: the weight is its path's cost
+  }
+  exact = batch_;
+  return upward ? up_[arc] : down_[arc];
+}
+
 std::string CchMetric::invariant_violation() const {
   const CchTopology& t = *topology_;
   for (std::uint32_t arc = 0; arc < t.arc_count(); ++arc) {
     const double up = derive(arc, true).weight, down = derive(arc, false).weight;
+    if (options_.lazy_rises) {
+      // Lower bounds: at or below what the triangles and the input give; witnesses may have risen.
+      if (up_[arc] > up || down_[arc] > down) {
+        return "arc " + std::to_string(arc) + " holds " + std::to_string(up_[arc]) + "/" + std::to_string(down_[arc]) +
+               " above what its triangles give, " + std::to_string(up) + "/" + std::to_string(down);
+      }
+      continue;
+    }
     if (up != up_[arc] || down != down_[arc]) {
       return "arc " + std::to_string(arc) + " holds " + std::to_string(up_[arc]) + "/" + std::to_string(down_[arc]) +
              " but its triangles give " + std::to_string(up) + "/" + std::to_string(down);
@@ -359,7 +431,10 @@ std::string CchMetric::invariant_violation() const {
 
 std::size_t CchMetric::memory_bytes() const {
   return (up_.size() + down_.size()) * sizeof(double) +
-         (via_up_.size() + via_down_.size() + slot_.size()) * sizeof(std::uint32_t) + queue_.memory_bytes() +
+         (via_up_.size() + via_down_.size() + slot_.size() + changed_below_.size() + parent_.size() + exact_up_.size() +
+          exact_down_.size()) *
+             sizeof(std::uint32_t) +
+         queue_.memory_bytes() +
          pending_.capacity() * sizeof(Pending) +
          [&] {
            std::size_t bytes = 0;

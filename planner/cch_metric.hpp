@@ -23,6 +23,13 @@
 
 namespace corridor::planner {
 
+struct CchMetricOptions {
+  // false: every change is carried up at once and every weight is exact (the paper's partial
+  // customization). true: rises wait until settle() finds them on a route; weights are lower
+  // bounds. One planner at a time may settle a lazy metric.
+  bool lazy_rises = false;
+};
+
 struct CustomizationStats {
   std::uint64_t recomputed = 0;  // arc directions re-derived
   std::uint64_t changed = 0;     // of those, arcs whose weight moved
@@ -32,7 +39,7 @@ class CchMetric {
  public:
   // Full customization. `topology` and `cost` must outlive the metric; std::invalid_argument when
   // the topology was built over another graph than the cost's.
-  CchMetric(const CchTopology& topology, const TravelCost& cost);
+  CchMetric(const CchTopology& topology, const TravelCost& cost, CchMetricOptions options = {});
 
   // Weight of arc `arc` from its lower end to its higher end, and back; kInfCost for none.
   [[nodiscard]] double up_s(std::uint32_t arc) const { return up_[arc]; }
@@ -46,9 +53,11 @@ class CchMetric {
   // Whether arc `arc` is open from its lower end to its higher end (`upward`), or back.
   [[nodiscard]] bool open(std::uint32_t arc, bool upward) const { return (open_[arc] & (upward ? kUp : kDown)) != 0; }
   [[nodiscard]] const TravelCost& cost() const { return *cost_; }
+  [[nodiscard]] bool lazy_rises() const { return options_.lazy_rises; }
 
   // The cost overlay behind `cost` changed these edges' conditions or these nodes' delays:
-  // re-derive what they reach. Appends the ids of arcs whose weights changed to `changed`.
+  // re-derive what they reach (lazy rises: only what got cheaper). Appends the ids of arcs whose
+  // weights changed to `changed`.
   CustomizationStats edges_changed(std::span<const EdgeId> edges, std::vector<std::uint32_t>& changed);
   CustomizationStats nodes_changed(std::span<const NodeId> nodes, std::vector<std::uint32_t>& changed);
 
@@ -60,7 +69,15 @@ class CchMetric {
   // its lower end (`upward`) or its higher end, excluding the first vertex, appended to `out`.
   void unpack(std::uint32_t arc, bool upward, std::vector<std::uint32_t>& out) const;
 
-  // Checks every arc against its lower triangles and its input; for tests. Empty when all hold.
+  // Makes arc `arc`'s weight in one direction exact, and returns it: the witnesses it unpacks
+  // through are settled first, bottom up, and a weight below the cost of its witness's path under
+  // today's inputs is re-derived from its triangles until the two agree. A lower bound that agrees
+  // with the cost of a real path is the cheapest. Appends the arcs it raised to `raised`. Does
+  // nothing on an eager metric, whose weights are always exact.
+  double settle(std::uint32_t arc, bool upward, std::vector<std::uint32_t>& raised);
+
+  // Checks every arc against its lower triangles and its input (lazy rises: that it lies at or
+  // below them); for tests. Empty when all hold.
   [[nodiscard]] std::string invariant_violation() const;
 
   [[nodiscard]] std::size_t memory_bytes() const;
@@ -96,6 +113,7 @@ class CchMetric {
 
   const CchTopology* topology_;
   const TravelCost* cost_;
+  CchMetricOptions options_;
   std::vector<double> up_;
   std::vector<double> down_;
   // Each weight's witness: the middle rank z of the lower triangle whose sum it is, or kNoCchArc
@@ -126,6 +144,16 @@ class CchMetric {
   // The queued arcs, taken in id order: ids follow the lower end's rank, and an arc only ever
   // queues arcs with higher lower ends.
   RisingIdQueue queue_;
+  // Lazy rises: what settle() need not look at again. Each report of changes is a new batch. An
+  // arc's weight, and the cheapest path below it, depend only on the inputs of arcs whose lower
+  // end lies in the arc's lower end's elimination subtree (its triangles' middles are lower
+  // neighbours, so descendants). An arc found exact in a batch no earlier than the last change in
+  // that subtree is exact still, and settle() returns at once instead of walking what it unpacks to.
+  std::uint32_t batch_ = 1;
+  std::vector<std::uint32_t> changed_below_;           // by rank: the batch of the last input change in its subtree
+  std::vector<std::uint32_t> parent_;                  // by rank: the topology's parent(), in one array for the climb
+  std::vector<std::uint32_t> exact_up_, exact_down_;  // by arc: the batch its weight was last found exact in
+  void mark_changed(std::uint32_t arc);
 };
 
 }  // namespace corridor::planner

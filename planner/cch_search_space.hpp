@@ -54,6 +54,7 @@ class CchSearchSpace {
   double move_starts(std::vector<EdgePoint> starts);
   [[nodiscard]] std::span<const Vertex> rewired() const { return rewired_; }
 
+  [[nodiscard]] const CchMetric& metric() const { return *metric_; }
   [[nodiscard]] std::span<const EdgePoint> starts() const { return flat_.starts(); }
   [[nodiscard]] std::span<const EdgePoint> goals() const { return flat_.goals(); }
   [[nodiscard]] bool is_start_edge(EdgeId e) const { return flat_.is_start_edge(e); }

@@ -245,10 +245,10 @@ std::size_t BasicDStarLite<Space>::memory_bytes() const {
 }
 
 template <class Space>
-Route BasicDStarLite<Space>::route() const {
+std::vector<typename BasicDStarLite<Space>::Via> BasicDStarLite<Space>::path() const {
   const Vertex start = space_.start();
   const Vertex goal = space_.goal();
-  if (cost_to_goal_s() >= kInfCost) return space_.route_along(std::vector<Via>{});
+  if (cost_to_goal_s() >= kInfCost) return {};
   std::vector<Via> vias;
   Vertex u = start;
   // Every arc costs more than zero except S arcs, so a path has at most vertex_count arcs.
@@ -264,11 +264,12 @@ Route BasicDStarLite<Space>::route() const {
         via = e;
       }
     });
-    if (!next.valid()) return space_.route_along(std::vector<Via>{});
+    if (!next.valid()) return {};
     vias.push_back(via);
     u = next;
   }
-  return space_.route_along(u == goal ? std::move(vias) : std::vector<Via>{});
+  if (u != goal) vias.clear();
+  return vias;
 }
 
 template class BasicDStarLite<SearchSpace>;

@@ -71,7 +71,9 @@ class BasicDStarLite {
   // rhs, not g: S has no predecessors, so the search may stop with S overconsistent.
   [[nodiscard]] double cost_to_goal_s() const { return cut_off_ ? kInfCost : rhs(space_.start()); }
   // The current route, extracted greedily from the g values; valid after replan().
-  [[nodiscard]] Route route() const;
+  [[nodiscard]] Route route() const { return space_.route_along(path()); }
+  // The arcs that route takes, from S to G; empty when there is none.
+  [[nodiscard]] std::vector<Via> path() const;
 
   [[nodiscard]] const Space& space() const { return space_; }
   // What this planner holds: its vertex pages, open list and start points. It grows with the part

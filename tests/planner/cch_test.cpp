@@ -9,6 +9,7 @@
 #include "planner/cch_topology.hpp"
 #include "planner/dstar_lite.hpp"
 #include "planner/one_to_one_search.hpp"
+#include "planner/settled_replan.hpp"
 #include "tests/planner/test_graphs.hpp"
 
 namespace corridor::planner {
@@ -131,6 +132,96 @@ TEST(CchMetric, PartialCustomizationEqualsFullCustomization) {
     }
   }
   EXPECT_EQ(batches, 40 * 30);
+}
+
+// With lazy rises, every weight stays at or below the full customization's, and settling an arc
+// brings it exactly there, however many batches ago the arc was last settled and whatever changed
+// below it since (a settled arc is not looked at again until something in its subtree changes).
+TEST(CchMetric, LazyRisesSettleToTheFullCustomization) {
+  int settled = 0, raised_total = 0;
+  for (std::uint64_t seed = 1; seed <= 30; ++seed) {
+    const auto grid = random_grid(seed, 7, 8);
+    const auto g = testing::with_random_restrictions(grid, seed, grid.edge_count() / 8);
+    CostOverlay overlay(g);
+    const TravelCost cost(g, overlay, testing::oracle_profile(seed, 25.0));
+    const CchTopology t(g.turns());
+    CchMetric lazy(t, cost, CchMetricOptions{.lazy_rises = true});
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    std::uniform_int_distribution<std::uint32_t> any_arc(0, static_cast<std::uint32_t>(t.arc_count() - 1));
+    for (int batch = 0; batch < 30; ++batch) {
+      std::vector<EdgeId> edges;
+      for (int k = 0; k < 4; ++k) {
+        const EdgeId e = testing::random_point(g, rng).edge;
+        const double r = unit(rng);
+        if (r < 0.1) {
+          overlay.close_edge(e);
+        } else if (r < 0.45) {
+          overlay.reset_edge(e);
+        } else {
+          overlay.set_edge(e, {1.0 + unit(rng) * 4.0, unit(rng) < 0.5 ? unit(rng) * 60.0 : 0.0});
+        }
+        edges.push_back(e);
+      }
+      std::vector<NodeId> nodes;
+      if (unit(rng) < 0.3) {
+        const NodeId n{std::uniform_int_distribution<std::uint32_t>(0, static_cast<std::uint32_t>(g.node_count() - 1))(rng)};
+        overlay.set_node_delay(n, unit(rng) < 0.5 ? 0.0 : unit(rng) * 30.0);
+        nodes.push_back(n);
+      }
+      std::vector<std::uint32_t> changed;
+      lazy.edges_changed(edges, changed);
+      lazy.nodes_changed(nodes, changed);
+      const CchMetric fresh(t, cost);
+      for (std::uint32_t arc = 0; arc < t.arc_count(); ++arc) {
+        ASSERT_LE(lazy.up_s(arc), fresh.up_s(arc)) << "seed " << seed << " batch " << batch << " arc " << arc;
+        ASSERT_LE(lazy.down_s(arc), fresh.down_s(arc)) << "seed " << seed << " batch " << batch << " arc " << arc;
+      }
+      ASSERT_EQ(lazy.invariant_violation(), "") << "seed " << seed << " batch " << batch;
+      // A few arcs per batch (the last batch: all), each in both directions, twice: the second
+      // settle finds it exact and raises nothing.
+      const std::uint32_t picks = batch == 29 ? static_cast<std::uint32_t>(t.arc_count()) : 6;
+      for (std::uint32_t i = 0; i < picks; ++i) {
+        const std::uint32_t arc = batch == 29 ? i : any_arc(rng);
+        for (const bool upward : {true, false}) {
+          std::vector<std::uint32_t> raised;
+          const double w = lazy.settle(arc, upward, raised);
+          const double expected = upward ? fresh.up_s(arc) : fresh.down_s(arc);
+          ASSERT_EQ(w, expected) << "seed " << seed << " batch " << batch << " arc " << arc;
+          ASSERT_EQ(upward ? lazy.up_s(arc) : lazy.down_s(arc), expected);
+          raised_total += static_cast<int>(raised.size());
+          std::vector<std::uint32_t> again;
+          EXPECT_EQ(lazy.settle(arc, upward, again), expected);
+          EXPECT_TRUE(again.empty());
+          ++settled;
+        }
+      }
+      ASSERT_EQ(lazy.invariant_violation(), "") << "seed " << seed << " batch " << batch;
+    }
+  }
+  EXPECT_GT(settled, 30 * 29 * 12);
+  EXPECT_GT(raised_total, 0);  // the rises did wait for settle()
+}
+
+// replan_settled settles the metric the planner searches, and no other.
+TEST(CchMetric, ReplanSettledRefusesAPlannerOnAnotherMetric) {
+  GridHierarchy h(4, 5, 5);
+  CchMetric other(h.t, h.cost, CchMetricOptions{.lazy_rises = true});
+  const EdgePoint a{EdgeId{0}, 0.0}, b{EdgeId{static_cast<std::uint32_t>(h.g.edge_count() - 1)}, 0.0};
+  CchDStarLite planner(h.metric, {a}, {b});
+  EXPECT_THROW((void)replan_settled(other, planner), std::invalid_argument);
+  EXPECT_EQ(replan_settled(h.metric, planner).repairs, 1u);  // eager: one repair, nothing to settle
+}
+
+// An eager metric is always exact: settle() reads the weight and raises nothing.
+TEST(CchMetric, SettleOnAnEagerMetricOnlyReads) {
+  GridHierarchy h(3, 6, 6);
+  std::vector<std::uint32_t> raised;
+  for (std::uint32_t arc = 0; arc < h.t.arc_count(); ++arc) {
+    EXPECT_EQ(h.metric.settle(arc, true, raised), h.metric.up_s(arc));
+    EXPECT_EQ(h.metric.settle(arc, false, raised), h.metric.down_s(arc));
+  }
+  EXPECT_TRUE(raised.empty());
 }
 
 // A shortcut unpacks into the turns it stands for, and they cost what it weighs.

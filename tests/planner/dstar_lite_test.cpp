@@ -9,6 +9,7 @@
 #include "planner/cch_metric.hpp"
 #include "planner/cch_topology.hpp"
 #include "planner/one_to_one_search.hpp"
+#include "planner/settled_replan.hpp"
 #include "maps/osm_import.hpp"
 #include "maps/synthetic_grid.hpp"
 #include "tests/planner/test_graphs.hpp"
@@ -75,16 +76,17 @@ TEST(DStarLite, InitialPlanMatchesDijkstraOnRandomGraphs) {
 // Thousands of random update sequences: cost increases and decreases on and off the route,
 // closures and reopenings, node and movement delay changes, and start moves, checked after every
 // replan. On the turn graph (eager and lazy raises), and on a contraction hierarchy, whose metric
-// is customized with each batch and checked against its own invariants.
-enum class Variant { eager, lazy, cch, cch_lazy };
+// is customized with each batch and checked against its own invariants; on a metric with lazy
+// rises too, where the replan settles the arcs its routes take (replan_settled).
+enum class Variant { eager, lazy, cch, cch_lazy, cch_settled };
 
 // One D* Lite of either kind, fed the same reports.
 class AnyDStarLite {
  public:
   AnyDStarLite(Variant v, const TravelCost& cost, std::vector<EdgePoint> starts, std::vector<EdgePoint> goals) {
-    if (v == Variant::cch || v == Variant::cch_lazy) {
+    if (v == Variant::cch || v == Variant::cch_lazy || v == Variant::cch_settled) {
       topology_.emplace(cost.graph().turns());
-      metric_.emplace(*topology_, cost);
+      metric_.emplace(*topology_, cost, CchMetricOptions{v == Variant::cch_settled});
       cch_.emplace(*metric_, std::move(starts), std::move(goals), DStarLiteOptions{v == Variant::cch_lazy});
     } else {
       flat_.emplace(cost, std::move(starts), std::move(goals), DStarLiteOptions{v == Variant::lazy});
@@ -104,7 +106,10 @@ class AnyDStarLite {
     cch_->nodes_changed(nodes);
     cch_->arcs_changed(arcs);
   }
-  ReplanStats replan() { return cch_ ? cch_->replan() : flat_->replan(); }
+  ReplanStats replan() {
+    if (!cch_) return flat_->replan();
+    return metric_->lazy_rises() ? replan_settled(*metric_, *cch_).stats : cch_->replan();
+  }
   [[nodiscard]] Route route() const { return cch_ ? cch_->route() : flat_->route(); }
   [[nodiscard]] double cost_to_goal_s() const { return cch_ ? cch_->cost_to_goal_s() : flat_->cost_to_goal_s(); }
   [[nodiscard]] std::string invariant_violation() const {
@@ -195,12 +200,14 @@ TEST_P(DStarLiteRepair, ReplanMatchesDijkstraAfterRandomUpdateSequences) {
 }
 
 INSTANTIATE_TEST_SUITE_P(EagerLazyAndCch, DStarLiteRepair,
-                         ::testing::Values(Variant::eager, Variant::lazy, Variant::cch, Variant::cch_lazy),
+                         ::testing::Values(Variant::eager, Variant::lazy, Variant::cch, Variant::cch_lazy,
+                                           Variant::cch_settled),
                          [](const ::testing::TestParamInfo<Variant>& p) {
                            switch (p.param) {
                              case Variant::lazy: return "lazy";
                              case Variant::cch: return "cch";
                              case Variant::cch_lazy: return "cch_lazy";
+                             case Variant::cch_settled: return "cch_settled";
                              default: return "eager";
                            }
                          });
