@@ -13,6 +13,7 @@
 #include "maps/progress.hpp"
 #include "planner/cch_metric.hpp"
 #include "planner/cch_topology.hpp"
+#include "planner/settled_replan.hpp"
 #include "planner/cost_overlay.hpp"
 #include "planner/dstar_lite.hpp"
 #include "planner/one_to_one_search.hpp"
@@ -117,12 +118,14 @@ class UpdateGenerator {
 
 void write_samples_csv(std::ostream& out, const std::vector<ReplanSample>& samples) {
   out << "trip,step,dstar_ms,astar_ms,dijkstra_ms,dstar_expanded,dstar_raised,astar_settled,route_edges_before,reachable,"
-         "dstar_path_checks,cch_customization_ms,cch_repair_ms,cch_expanded,cch_changed_arcs\n";
+         "dstar_path_checks,cch_customization_ms,cch_repair_ms,cch_expanded,cch_changed_arcs,lazy_customization_ms,"
+         "lazy_repair_ms,lazy_repairs\n";
   for (const ReplanSample& r : samples) {
     out << r.trip << ',' << r.step << ',' << r.dstar_ms << ',' << r.astar_ms << ',' << r.dijkstra_ms << ','
         << r.dstar_expanded << ',' << r.dstar_raised << ',' << r.astar_settled << ',' << r.route_edges_before << ','
         << (r.reachable ? 1 : 0) << ',' << r.dstar_path_checks << ',' << r.cch_customization_ms << ','
-        << r.cch_repair_ms << ',' << r.cch_expanded << ',' << r.cch_changed_arcs << '\n';
+        << r.cch_repair_ms << ',' << r.cch_expanded << ',' << r.cch_changed_arcs << ',' << r.lazy_customization_ms << ','
+        << r.lazy_repair_ms << ',' << r.lazy_repairs << '\n';
   }
 }
 
@@ -177,7 +180,9 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
   res.cch_topology_bytes = topology.memory_bytes();
   std::vector<double> t_cch_full, t_cch, t_cch_custom, t_cch_repair, t_cch0, cch_bytes;
   double cch_changed = 0, cch_expanded = 0, cch_vertices = 0;
-  std::vector<std::uint32_t> changed_arcs;
+  std::vector<double> t_lazy, t_lazy_custom, t_lazy_repair;
+  double lazy_changed = 0, lazy_repairs = 0, lazy_settled = 0;
+  std::vector<std::uint32_t> changed_arcs, lazy_arcs;
   maps::ProgressBar progress("bench replan", config.trips);
 
   for (std::uint32_t trip = 0; trip < config.trips; ++trip) {
@@ -214,6 +219,9 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
     cch_dstar.replan();
     (void)cch_dstar.route();
     t_cch0.push_back(ms_since(t0));
+    planner::CchMetric lazy_metric(topology, cost, planner::CchMetricOptions{.lazy_rises = true});
+    planner::CchDStarLite lazy_dstar(lazy_metric, {start}, {goal}, planner::DStarLiteOptions{config.lazy_raises});
+    (void)planner::replan_settled(lazy_metric, lazy_dstar);
 
     std::unordered_set<std::uint32_t> changed_set;
     for (std::uint32_t step = 0; step < config.max_replans_per_trip && route.found; ++step) {
@@ -256,6 +264,24 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
       cch_expanded += static_cast<double>(cch_stats.expanded);
       cch_vertices += static_cast<double>(cch_dstar.space().upward_size() + cch_dstar.space().downward_size());
 
+      t0 = Clock::now();
+      lazy_arcs.clear();
+      (void)lazy_metric.edges_changed(changed, lazy_arcs);
+      const double lazy_custom_ms = ms_since(t0);
+      t0 = Clock::now();
+      lazy_dstar.move_start({*position});
+      lazy_dstar.edges_changed(changed);
+      lazy_dstar.arcs_changed(lazy_arcs);
+      const planner::SettledReplan lazy = planner::replan_settled(lazy_metric, lazy_dstar);
+      const double lazy_repair_ms = ms_since(t0);
+      t_lazy_custom.push_back(lazy_custom_ms);
+      t_lazy_repair.push_back(lazy_repair_ms);
+      t_lazy.push_back(lazy_custom_ms + lazy_repair_ms);
+      lazy_changed += static_cast<double>(lazy_arcs.size());
+      lazy_repairs += lazy.repairs;
+      lazy_settled += static_cast<double>(lazy.settled);
+      res.lazy_max_repairs = std::max<std::uint64_t>(res.lazy_max_repairs, lazy.repairs);
+
       const planner::SearchSpace space(cost, {*position}, {goal});
       planner::SearchStats s_astar, s_dijkstra;
       t0 = Clock::now();
@@ -279,12 +305,17 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
           spdlog::warn("event=cch_mismatch trip={} step={} cch_s={:.9f} route_s={:.9f} dijkstra_s={:.9f}", trip, step,
                        cch_dstar.cost_to_goal_s(), cch_route.travel_time_s, d.travel_time_s);
         }
+        if (costs_differ(lazy_dstar.cost_to_goal_s(), d.travel_time_s) || costs_differ(lazy.route.travel_time_s, d.travel_time_s)) {
+          ++res.lazy_mismatches;
+          spdlog::warn("event=lazy_cch_mismatch trip={} step={} bound_s={:.9f} route_s={:.9f} dijkstra_s={:.9f}", trip,
+                       step, lazy_dstar.cost_to_goal_s(), lazy.route.travel_time_s, d.travel_time_s);
+        }
       }
       ++res.replans;
       res.samples.push_back({trip, step, t_dstar.back(), t_astar.back(), config.run_dijkstra ? t_dijkstra.back() : 0.0,
                              stats.expanded, stats.underconsistent, s_astar.settled, stats.path_checks,
                              route.edges.size(), next.found, custom_ms, repair_ms, cch_stats.expanded,
-                             changed_arcs.size()});
+                             changed_arcs.size(), lazy_custom_ms, lazy_repair_ms, lazy.repairs});
       // Unchanged means: the new route is the rest of the old one from the vehicle's edge on.
       const auto from = std::find(route.edges.begin(), route.edges.end(), next.edges.empty() ? kInvalidEdge : next.edges.front());
       if (!std::equal(from, route.edges.end(), next.edges.begin(), next.edges.end())) ++res.route_changes;
@@ -323,6 +354,12 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
   res.cch_bytes_per_planner =
       cch_bytes.empty() ? 0.0 : std::accumulate(cch_bytes.begin(), cch_bytes.end(), 0.0) / static_cast<double>(cch_bytes.size());
   res.cch_max_bytes_per_planner = cch_bytes.empty() ? 0.0 : *std::max_element(cch_bytes.begin(), cch_bytes.end());
+  res.lazy_dstar = summarize_ms(t_lazy);
+  res.lazy_customization = summarize_ms(t_lazy_custom);
+  res.lazy_repair = summarize_ms(t_lazy_repair);
+  res.lazy_mean_changed_arcs = lazy_changed / n;
+  res.lazy_mean_repairs = lazy_repairs / n;
+  res.lazy_mean_settled = lazy_settled / n;
   return res;
 }
 
@@ -396,6 +433,16 @@ nlohmann::json to_json(const ReplanBenchResult& r, const ReplanBenchConfig& c) {
   j["dstar_cch"]["mean_bytes_per_planner"] = r.cch_bytes_per_planner;
   j["dstar_cch"]["max_bytes_per_planner"] = r.cch_max_bytes_per_planner;
   j["dstar_cch"]["mismatches"] = r.cch_mismatches;
+  j["dstar_cch_lazy"] = to_json(r.lazy_dstar);
+  j["dstar_cch_lazy"]["customization"] = to_json(r.lazy_customization);
+  j["dstar_cch_lazy"]["repair"] = to_json(r.lazy_repair);
+  j["dstar_cch_lazy"]["mean_changed_arcs"] = r.lazy_mean_changed_arcs;
+  j["dstar_cch_lazy"]["mean_repairs"] = r.lazy_mean_repairs;
+  j["dstar_cch_lazy"]["max_repairs"] = r.lazy_max_repairs;
+  j["dstar_cch_lazy"]["mean_settled_arcs"] = r.lazy_mean_settled;
+  j["dstar_cch_lazy"]["mismatches"] = r.lazy_mismatches;
+  j["dstar_cch_lazy"]["speedup_p50_vs_dstar_cch"] = ratio(r.cch_dstar.p50_ms, r.lazy_dstar.p50_ms);
+  j["dstar_cch_lazy"]["speedup_p99_vs_dstar_cch"] = ratio(r.cch_dstar.p99_ms, r.lazy_dstar.p99_ms);
   return j;
 }
 

@@ -60,6 +60,9 @@ struct ReplanSample {
   double cch_repair_ms = 0;
   std::uint64_t cch_expanded = 0;
   std::uint64_t cch_changed_arcs = 0;
+  double lazy_customization_ms = 0;
+  double lazy_repair_ms = 0;
+  std::uint32_t lazy_repairs = 0;
 };
 
 struct ReplanBenchResult {
@@ -95,11 +98,20 @@ struct ReplanBenchResult {
   double cch_bytes_per_planner = 0;
   double cch_max_bytes_per_planner = 0;
   std::size_t cch_mismatches = 0;
+  // The same on a metric with lazy rises (planner/settled_replan.hpp): the customization carries
+  // only decreases up; the repair settles the rises its routes meet and repairs again.
+  LatencySummary lazy_dstar, lazy_customization, lazy_repair;
+  double lazy_mean_changed_arcs = 0;  // arcs the customization lowered
+  double lazy_mean_repairs = 0;       // D* Lite repairs per replan (1: the first route held)
+  double lazy_mean_settled = 0;       // arcs settling raised, per replan
+  std::uint64_t lazy_max_repairs = 0;
+  std::size_t lazy_mismatches = 0;
   std::vector<ReplanSample> samples;
 };
 
 // trip,step,dstar_ms,astar_ms,dijkstra_ms,dstar_expanded,dstar_raised,astar_settled,route_edges_before,reachable,
-// dstar_path_checks,cch_customization_ms,cch_repair_ms,cch_expanded,cch_changed_arcs
+// dstar_path_checks,cch_customization_ms,cch_repair_ms,cch_expanded,cch_changed_arcs,lazy_customization_ms,
+// lazy_repair_ms,lazy_repairs
 void write_samples_csv(std::ostream& out, const std::vector<ReplanSample>& samples);
 
 // Throws std::invalid_argument for a config that cannot run (no trips, negative fractions, ...).
