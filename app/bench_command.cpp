@@ -81,6 +81,15 @@ void register_bench_command(CLI::App& app) {
   replan->add_flag("!--no-dijkstra", o->config.run_dijkstra, "skip the Dijkstra baseline (and the mismatch check)");
   replan->add_flag("--lazy-raises", o->config.lazy_raises,
                    "D* Lite repairs cost increases only where they reach the path (Delayed D*), not at once");
+  replan->add_option_function<std::string>(
+             "--hierarchy",
+             [o](const std::string& v) {
+               o->config.eager_hierarchy = v == "both" || v == "eager";
+               o->config.lazy_hierarchy = v == "both" || v == "lazy";
+             },
+             "D* Lite on the contraction hierarchy: its metric customized eagerly, with lazy rises, both, or none "
+             "(default both)")
+      ->check(CLI::IsMember({"both", "eager", "lazy", "none"}));
   replan->callback([o] { run_replan(*o); });
 
   auto s = std::make_shared<std::pair<MapOptions, bench::ServeBenchConfig>>();

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <numeric>
+#include <optional>
 #include <chrono>
 #include <cmath>
 #include <random>
@@ -174,14 +175,18 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
   planner::OneToOneSearch astar, dijkstra;
   std::uniform_int_distribution<std::uint32_t> any_edge(0, static_cast<std::uint32_t>(graph.edge_count() - 1));
   auto t_pre = Clock::now();
-  const planner::CchTopology topology(graph.turns());
-  res.cch_preprocessing_s = ms_since(t_pre) / 1000.0;
-  res.cch_arcs = topology.arc_count();
-  res.cch_topology_bytes = topology.memory_bytes();
+  std::optional<planner::CchTopology> topology;
+  if (config.eager_hierarchy || config.lazy_hierarchy) {
+    topology.emplace(graph.turns());
+    res.cch_preprocessing_s = ms_since(t_pre) / 1000.0;
+    res.cch_arcs = topology->arc_count();
+    res.cch_topology_bytes = topology->memory_bytes();
+  }
   std::vector<double> t_cch_full, t_cch, t_cch_custom, t_cch_repair, t_cch0, cch_bytes;
   double cch_changed = 0, cch_expanded = 0, cch_vertices = 0;
   std::vector<double> t_lazy, t_lazy_custom, t_lazy_repair;
   double lazy_changed = 0, lazy_repairs = 0, lazy_settled = 0;
+  std::vector<double> lazy_bytes;
   std::vector<std::uint32_t> changed_arcs, lazy_arcs;
   maps::ProgressBar progress("bench replan", config.trips);
 
@@ -210,18 +215,27 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
     (void)astar.run(planner::SearchSpace(cost, {start}, {goal}), true);
     t_astar0.push_back(ms_since(t0));
     ++res.trips;
-    t0 = Clock::now();
-    planner::CchMetric metric(topology, cost);
-    t_cch_full.push_back(ms_since(t0));
-    res.cch_metric_bytes = metric.memory_bytes();
-    t0 = Clock::now();
-    planner::CchDStarLite cch_dstar(metric, {start}, {goal}, planner::DStarLiteOptions{config.lazy_raises});
-    cch_dstar.replan();
-    (void)cch_dstar.route();
-    t_cch0.push_back(ms_since(t0));
-    planner::CchMetric lazy_metric(topology, cost, planner::CchMetricOptions{.lazy_rises = true});
-    planner::CchDStarLite lazy_dstar(lazy_metric, {start}, {goal}, planner::DStarLiteOptions{config.lazy_raises});
-    (void)planner::replan_settled(lazy_metric, lazy_dstar);
+    std::optional<planner::CchMetric> metric, lazy_metric;
+    std::optional<planner::CchDStarLite> cch_dstar, lazy_dstar;
+    if (config.eager_hierarchy) {
+      t0 = Clock::now();
+      metric.emplace(*topology, cost);
+      t_cch_full.push_back(ms_since(t0));
+      res.cch_metric_bytes = metric->memory_bytes();
+      t0 = Clock::now();
+      cch_dstar.emplace(*metric, std::vector<EdgePoint>{start}, std::vector<EdgePoint>{goal},
+                        planner::DStarLiteOptions{config.lazy_raises});
+      cch_dstar->replan();
+      (void)cch_dstar->route();
+      t_cch0.push_back(ms_since(t0));
+    }
+    if (config.lazy_hierarchy) {
+      lazy_metric.emplace(*topology, cost, planner::CchMetricOptions{.lazy_rises = true});
+      if (!metric) res.cch_metric_bytes = lazy_metric->memory_bytes();
+      lazy_dstar.emplace(*lazy_metric, std::vector<EdgePoint>{start}, std::vector<EdgePoint>{goal},
+                         planner::DStarLiteOptions{config.lazy_raises});
+      (void)planner::replan_settled(*lazy_metric, *lazy_dstar);
+    }
 
     std::unordered_set<std::uint32_t> changed_set;
     for (std::uint32_t step = 0; step < config.max_replans_per_trip && route.found; ++step) {
@@ -246,41 +260,50 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
       raised += static_cast<double>(stats.underconsistent);
       path_checks += static_cast<double>(stats.path_checks);
 
-      t0 = Clock::now();
+      double custom_ms = 0, repair_ms = 0;
+      planner::ReplanStats cch_stats;
+      planner::Route cch_route;
       changed_arcs.clear();
-      (void)metric.edges_changed(changed, changed_arcs);
-      const double custom_ms = ms_since(t0);
-      t0 = Clock::now();
-      cch_dstar.move_start({*position});
-      cch_dstar.edges_changed(changed);
-      cch_dstar.arcs_changed(changed_arcs);
-      const auto cch_stats = cch_dstar.replan();
-      const planner::Route cch_route = cch_dstar.route();
-      const double repair_ms = ms_since(t0);
-      t_cch_custom.push_back(custom_ms);
-      t_cch_repair.push_back(repair_ms);
-      t_cch.push_back(custom_ms + repair_ms);
-      cch_changed += static_cast<double>(changed_arcs.size());
-      cch_expanded += static_cast<double>(cch_stats.expanded);
-      cch_vertices += static_cast<double>(cch_dstar.space().upward_size() + cch_dstar.space().downward_size());
+      if (cch_dstar) {
+        t0 = Clock::now();
+        (void)metric->edges_changed(changed, changed_arcs);
+        custom_ms = ms_since(t0);
+        t0 = Clock::now();
+        cch_dstar->move_start({*position});
+        cch_dstar->edges_changed(changed);
+        cch_dstar->arcs_changed(changed_arcs);
+        cch_stats = cch_dstar->replan();
+        cch_route = cch_dstar->route();
+        repair_ms = ms_since(t0);
+        t_cch_custom.push_back(custom_ms);
+        t_cch_repair.push_back(repair_ms);
+        t_cch.push_back(custom_ms + repair_ms);
+        cch_changed += static_cast<double>(changed_arcs.size());
+        cch_expanded += static_cast<double>(cch_stats.expanded);
+        cch_vertices += static_cast<double>(cch_dstar->space().upward_size() + cch_dstar->space().downward_size());
+      }
 
-      t0 = Clock::now();
-      lazy_arcs.clear();
-      (void)lazy_metric.edges_changed(changed, lazy_arcs);
-      const double lazy_custom_ms = ms_since(t0);
-      t0 = Clock::now();
-      lazy_dstar.move_start({*position});
-      lazy_dstar.edges_changed(changed);
-      lazy_dstar.arcs_changed(lazy_arcs);
-      const planner::SettledReplan lazy = planner::replan_settled(lazy_metric, lazy_dstar);
-      const double lazy_repair_ms = ms_since(t0);
-      t_lazy_custom.push_back(lazy_custom_ms);
-      t_lazy_repair.push_back(lazy_repair_ms);
-      t_lazy.push_back(lazy_custom_ms + lazy_repair_ms);
-      lazy_changed += static_cast<double>(lazy_arcs.size());
-      lazy_repairs += lazy.repairs;
-      lazy_settled += static_cast<double>(lazy.settled);
-      res.lazy_max_repairs = std::max<std::uint64_t>(res.lazy_max_repairs, lazy.repairs);
+      double lazy_custom_ms = 0, lazy_repair_ms = 0;
+      planner::SettledReplan lazy;
+      if (lazy_dstar) {
+        t0 = Clock::now();
+        lazy_arcs.clear();
+        (void)lazy_metric->edges_changed(changed, lazy_arcs);
+        lazy_custom_ms = ms_since(t0);
+        t0 = Clock::now();
+        lazy_dstar->move_start({*position});
+        lazy_dstar->edges_changed(changed);
+        lazy_dstar->arcs_changed(lazy_arcs);
+        lazy = planner::replan_settled(*lazy_metric, *lazy_dstar);
+        lazy_repair_ms = ms_since(t0);
+        t_lazy_custom.push_back(lazy_custom_ms);
+        t_lazy_repair.push_back(lazy_repair_ms);
+        t_lazy.push_back(lazy_custom_ms + lazy_repair_ms);
+        lazy_changed += static_cast<double>(lazy_arcs.size());
+        lazy_repairs += lazy.repairs;
+        lazy_settled += static_cast<double>(lazy.settled);
+        res.lazy_max_repairs = std::max<std::uint64_t>(res.lazy_max_repairs, lazy.repairs);
+      }
 
       const planner::SearchSpace space(cost, {*position}, {goal});
       planner::SearchStats s_astar, s_dijkstra;
@@ -300,15 +323,17 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
                        dstar.cost_to_goal_s(), d.travel_time_s);
         }
         if (costs_differ(a.travel_time_s, d.travel_time_s)) ++res.astar_mismatches;
-        if (costs_differ(cch_dstar.cost_to_goal_s(), d.travel_time_s) || costs_differ(cch_route.travel_time_s, d.travel_time_s)) {
+        if (cch_dstar && (costs_differ(cch_dstar->cost_to_goal_s(), d.travel_time_s) ||
+                          costs_differ(cch_route.travel_time_s, d.travel_time_s))) {
           ++res.cch_mismatches;
           spdlog::warn("event=cch_mismatch trip={} step={} cch_s={:.9f} route_s={:.9f} dijkstra_s={:.9f}", trip, step,
-                       cch_dstar.cost_to_goal_s(), cch_route.travel_time_s, d.travel_time_s);
+                       cch_dstar->cost_to_goal_s(), cch_route.travel_time_s, d.travel_time_s);
         }
-        if (costs_differ(lazy_dstar.cost_to_goal_s(), d.travel_time_s) || costs_differ(lazy.route.travel_time_s, d.travel_time_s)) {
+        if (lazy_dstar && (costs_differ(lazy_dstar->cost_to_goal_s(), d.travel_time_s) ||
+                           costs_differ(lazy.route.travel_time_s, d.travel_time_s))) {
           ++res.lazy_mismatches;
           spdlog::warn("event=lazy_cch_mismatch trip={} step={} bound_s={:.9f} route_s={:.9f} dijkstra_s={:.9f}", trip,
-                       step, lazy_dstar.cost_to_goal_s(), lazy.route.travel_time_s, d.travel_time_s);
+                       step, lazy_dstar->cost_to_goal_s(), lazy.route.travel_time_s, d.travel_time_s);
         }
       }
       ++res.replans;
@@ -322,7 +347,8 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
       route = std::move(next);
     }
     planner_bytes.push_back(static_cast<double>(dstar.memory_bytes()));
-    cch_bytes.push_back(static_cast<double>(cch_dstar.memory_bytes()));
+    if (cch_dstar) cch_bytes.push_back(static_cast<double>(cch_dstar->memory_bytes()));
+    if (lazy_dstar) lazy_bytes.push_back(static_cast<double>(lazy_dstar->memory_bytes()));
     progress.update(trip + 1);
   }
   progress.finish();
@@ -360,6 +386,8 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
   res.lazy_mean_changed_arcs = lazy_changed / n;
   res.lazy_mean_repairs = lazy_repairs / n;
   res.lazy_mean_settled = lazy_settled / n;
+  res.lazy_bytes_per_planner =
+      lazy_bytes.empty() ? 0.0 : std::accumulate(lazy_bytes.begin(), lazy_bytes.end(), 0.0) / static_cast<double>(lazy_bytes.size());
   return res;
 }
 
@@ -367,6 +395,31 @@ nlohmann::json to_json(const LatencySummary& s) {
   return {{"count", s.count},   {"p50_ms", s.p50_ms}, {"p95_ms", s.p95_ms}, {"p99_ms", s.p99_ms},
           {"max_ms", s.max_ms}, {"mean_ms", s.mean_ms}};
 }
+
+namespace {
+
+// D* Lite on the hierarchy with lazy rises, beside the eager one when that ran too.
+nlohmann::json lazy_json(nlohmann::json j, const ReplanBenchResult& r) {
+  if (r.lazy_dstar.count == 0) return j;
+  nlohmann::json& l = j["dstar_cch_lazy"];
+  l = to_json(r.lazy_dstar);
+  l["customization"] = to_json(r.lazy_customization);
+  l["repair"] = to_json(r.lazy_repair);
+  l["mean_changed_arcs"] = r.lazy_mean_changed_arcs;
+  l["mean_repairs"] = r.lazy_mean_repairs;
+  l["max_repairs"] = r.lazy_max_repairs;
+  l["mean_settled_arcs"] = r.lazy_mean_settled;
+  l["mean_bytes_per_planner"] = r.lazy_bytes_per_planner;
+  l["metric_bytes"] = r.cch_metric_bytes;
+  l["mismatches"] = r.lazy_mismatches;
+  if (r.cch_dstar.count > 0) {
+    l["speedup_p50_vs_dstar_cch"] = r.lazy_dstar.p50_ms > 0 ? r.cch_dstar.p50_ms / r.lazy_dstar.p50_ms : 0.0;
+    l["speedup_p99_vs_dstar_cch"] = r.lazy_dstar.p99_ms > 0 ? r.cch_dstar.p99_ms / r.lazy_dstar.p99_ms : 0.0;
+  }
+  return j;
+}
+
+}  // namespace
 
 nlohmann::json to_json(const ReplanBenchResult& r, const ReplanBenchConfig& c) {
   auto ratio = [](double a, double b) { return b > 0 ? a / b : 0.0; };
@@ -417,6 +470,12 @@ nlohmann::json to_json(const ReplanBenchResult& r, const ReplanBenchConfig& c) {
   j["speedup_p50_vs_dijkstra"] = c.run_dijkstra ? ratio(r.dijkstra.p50_ms, r.dstar.p50_ms) : 0.0;
   j["mismatches"] = r.mismatches;
   j["astar_mismatches"] = r.astar_mismatches;
+  j["hierarchy"] = c.eager_hierarchy ? (c.lazy_hierarchy ? "both" : "eager") : (c.lazy_hierarchy ? "lazy" : "none");
+  if (c.eager_hierarchy || c.lazy_hierarchy) {
+    j["hierarchy_preprocessing_s"] = r.cch_preprocessing_s;
+    j["hierarchy_arcs"] = r.cch_arcs;
+  }
+  if (!c.eager_hierarchy) return lazy_json(j, r);
   j["dstar_cch"] = to_json(r.cch_dstar);
   j["dstar_cch"]["customization"] = to_json(r.cch_customization);
   j["dstar_cch"]["repair"] = to_json(r.cch_repair);
@@ -433,17 +492,7 @@ nlohmann::json to_json(const ReplanBenchResult& r, const ReplanBenchConfig& c) {
   j["dstar_cch"]["mean_bytes_per_planner"] = r.cch_bytes_per_planner;
   j["dstar_cch"]["max_bytes_per_planner"] = r.cch_max_bytes_per_planner;
   j["dstar_cch"]["mismatches"] = r.cch_mismatches;
-  j["dstar_cch_lazy"] = to_json(r.lazy_dstar);
-  j["dstar_cch_lazy"]["customization"] = to_json(r.lazy_customization);
-  j["dstar_cch_lazy"]["repair"] = to_json(r.lazy_repair);
-  j["dstar_cch_lazy"]["mean_changed_arcs"] = r.lazy_mean_changed_arcs;
-  j["dstar_cch_lazy"]["mean_repairs"] = r.lazy_mean_repairs;
-  j["dstar_cch_lazy"]["max_repairs"] = r.lazy_max_repairs;
-  j["dstar_cch_lazy"]["mean_settled_arcs"] = r.lazy_mean_settled;
-  j["dstar_cch_lazy"]["mismatches"] = r.lazy_mismatches;
-  j["dstar_cch_lazy"]["speedup_p50_vs_dstar_cch"] = ratio(r.cch_dstar.p50_ms, r.lazy_dstar.p50_ms);
-  j["dstar_cch_lazy"]["speedup_p99_vs_dstar_cch"] = ratio(r.cch_dstar.p99_ms, r.lazy_dstar.p99_ms);
-  return j;
+  return lazy_json(j, r);
 }
 
 }  // namespace corridor::bench

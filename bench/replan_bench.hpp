@@ -28,6 +28,10 @@ struct ReplanBenchConfig {
   double min_trip_m = 0.0;         // straight-line; 0 = a third of the map's diagonal, at most 5 km
   bool run_dijkstra = true;
   bool lazy_raises = false;        // D* Lite's lazy raises (DStarLiteOptions); default: the eager paper version
+  // D* Lite on the contraction hierarchy, with the metric customized eagerly (dstar_cch) and with
+  // lazy rises (dstar_cch_lazy); each can be left out (a grid's hierarchy is slow to customize).
+  bool eager_hierarchy = true;
+  bool lazy_hierarchy = true;
   std::uint32_t max_replans_per_trip = 1000;
 };
 
@@ -105,6 +109,7 @@ struct ReplanBenchResult {
   double lazy_mean_repairs = 0;       // D* Lite repairs per replan (1: the first route held)
   double lazy_mean_settled = 0;       // arcs settling raised, per replan
   std::uint64_t lazy_max_repairs = 0;
+  double lazy_bytes_per_planner = 0;
   std::size_t lazy_mismatches = 0;
   std::vector<ReplanSample> samples;
 };

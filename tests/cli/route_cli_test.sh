@@ -131,6 +131,11 @@ for a in ("dstar", "astar", "dijkstra"):
         assert j[a][q] >= 0
 assert j["graph"]["nodes"] > 0 and j["replans"] > 0
 assert j["mismatches"] == 0, j["mismatches"]
+# D* Lite on the hierarchy, eager and with lazy rises, is checked against Dijkstra too.
+for h in ("dstar_cch", "dstar_cch_lazy"):
+    assert j[h]["count"] == j["replans"], h
+    assert j[h]["mismatches"] == 0, (h, j[h]["mismatches"])
+assert j["dstar_cch_lazy"]["mean_repairs"] >= 1
 PY
 then pass; else fail "bench replan output"; fi
 
