@@ -184,7 +184,7 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
   }
   std::vector<double> t_cch_full, t_cch, t_cch_custom, t_cch_repair, t_cch0, cch_bytes;
   double cch_changed = 0, cch_expanded = 0, cch_vertices = 0;
-  std::vector<double> t_lazy, t_lazy_custom, t_lazy_repair;
+  std::vector<double> t_lazy, t_lazy_custom, t_lazy_repair, t_lazy_full;
   double lazy_changed = 0, lazy_repairs = 0, lazy_settled = 0;
   std::vector<double> lazy_bytes;
   std::vector<std::uint32_t> changed_arcs, lazy_arcs;
@@ -230,8 +230,10 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
       t_cch0.push_back(ms_since(t0));
     }
     if (config.lazy_hierarchy) {
+      t0 = Clock::now();
       lazy_metric.emplace(*topology, cost, planner::CchMetricOptions{.lazy_rises = true});
-      if (!metric) res.cch_metric_bytes = lazy_metric->memory_bytes();
+      t_lazy_full.push_back(ms_since(t0));
+      res.lazy_metric_bytes = lazy_metric->memory_bytes();
       lazy_dstar.emplace(*lazy_metric, std::vector<EdgePoint>{start}, std::vector<EdgePoint>{goal},
                          planner::DStarLiteOptions{config.lazy_raises});
       (void)planner::replan_settled(*lazy_metric, *lazy_dstar);
@@ -383,6 +385,7 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
   res.lazy_dstar = summarize_ms(t_lazy);
   res.lazy_customization = summarize_ms(t_lazy_custom);
   res.lazy_repair = summarize_ms(t_lazy_repair);
+  res.lazy_customization_full = summarize_ms(t_lazy_full);
   res.lazy_mean_changed_arcs = lazy_changed / n;
   res.lazy_mean_repairs = lazy_repairs / n;
   res.lazy_mean_settled = lazy_settled / n;
@@ -410,7 +413,9 @@ nlohmann::json lazy_json(nlohmann::json j, const ReplanBenchResult& r) {
   l["max_repairs"] = r.lazy_max_repairs;
   l["mean_settled_arcs"] = r.lazy_mean_settled;
   l["mean_bytes_per_planner"] = r.lazy_bytes_per_planner;
-  l["metric_bytes"] = r.cch_metric_bytes;
+  l["full_customization"] = to_json(r.lazy_customization_full);
+  l["metric_bytes"] = r.lazy_metric_bytes;
+  l["topology_bytes"] = r.cch_topology_bytes;
   l["mismatches"] = r.lazy_mismatches;
   if (r.cch_dstar.count > 0) {
     l["speedup_p50_vs_dstar_cch"] = r.lazy_dstar.p50_ms > 0 ? r.cch_dstar.p50_ms / r.lazy_dstar.p50_ms : 0.0;

@@ -110,6 +110,8 @@ struct ReplanBenchResult {
   double lazy_mean_settled = 0;       // arcs settling raised, per replan
   std::uint64_t lazy_max_repairs = 0;
   double lazy_bytes_per_planner = 0;
+  std::size_t lazy_metric_bytes = 0;   // with its batch stamps and parent array
+  LatencySummary lazy_customization_full;
   std::size_t lazy_mismatches = 0;
   std::vector<ReplanSample> samples;
 };

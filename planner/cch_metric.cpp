@@ -358,8 +358,8 @@ void CchMetric::unpack(std::uint32_t arc, bool upward, std::vector<std::uint32_t
 double CchMetric::settle(std::uint32_t arc, bool upward, std::vector<std::uint32_t>& raised) {
   if (!options_.lazy_rises) return upward ? up_[arc] : down_[arc];
   const CchTopology& t = *topology_;
-  // Every weight is at most its triangles' sums and its input (they only rise between settles),
-  // and so at most its true value. Each round either ends or moves the witness to another triangle
+  // Every weight is at most its triangles' sums and its input (a fall is carried up at once, a
+  // rise only raises them), and so at most its true value. Each round either ends or moves the witness to another triangle
   // of lower-bound sum; sums only rise as witnesses settle, so the rounds end.
   std::uint32_t& exact = upward ? exact_up_[arc] : exact_down_[arc];
   if (exact >= changed_below_[t.tail(arc)]) return upward ? up_[arc] : down_[arc];
@@ -379,9 +379,10 @@ double CchMetric::settle(std::uint32_t arc, bool upward, std::vector<std::uint32
     if (witnessed == w) break;
     const Derived d = derive(arc, upward);
     assert(d.weight >= w);
+    // A tie through another witness moves no weight: nothing for the planner to repair.
+    if (d.weight != w) raised.push_back(arc);
     w = d.weight;
     (upward ? via_up_[arc] : via_down_[arc]) = d.via;
-    raised.push_back(arc);
     if (d.via == z) break;  // the same witness, now settled: the weight is its path's cost
   }
   exact = batch_;

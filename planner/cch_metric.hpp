@@ -1,6 +1,7 @@
 // The metric half of a customizable contraction hierarchy: one weight per arc and direction of a
 // CchTopology, derived from a TravelCost (one vehicle profile over the live cost overlay), so that
-// every arc holds the cost of the cheapest path between its ends through lower ranks. Built by a
+// every arc holds the cost of the cheapest path between its ends through lower ranks (with lazy
+// rises, below: a lower bound of it). Built by a
 // full customization; kept current by partial customization as congestion changes, which
 // re-derives only the arcs an input change can reach (Dibbelt, Strasser & Wagner 2016, §5). The
 // arcs whose weights moved are handed back, so the searches above can repair themselves.
@@ -26,7 +27,8 @@ namespace corridor::planner {
 struct CchMetricOptions {
   // false: every change is carried up at once and every weight is exact (the paper's partial
   // customization). true: rises wait until settle() finds them on a route; weights are lower
-  // bounds. One planner at a time may settle a lazy metric.
+  // bounds. A lazy metric serves one planner: the arcs settle() raises are reported to that
+  // planner alone, and another planner's values would stay on the old weights.
   bool lazy_rises = false;
 };
 
@@ -41,7 +43,8 @@ class CchMetric {
   // the topology was built over another graph than the cost's.
   CchMetric(const CchTopology& topology, const TravelCost& cost, CchMetricOptions options = {});
 
-  // Weight of arc `arc` from its lower end to its higher end, and back; kInfCost for none.
+  // Weight of arc `arc` from its lower end to its higher end, and back; kInfCost for none. With
+  // lazy rises, a lower bound until settle() makes it exact.
   [[nodiscard]] double up_s(std::uint32_t arc) const { return up_[arc]; }
   [[nodiscard]] double down_s(std::uint32_t arc) const { return down_[arc]; }
   [[nodiscard]] const CchTopology& topology() const { return *topology_; }
@@ -54,6 +57,12 @@ class CchMetric {
   [[nodiscard]] bool open(std::uint32_t arc, bool upward) const { return (open_[arc] & (upward ? kUp : kDown)) != 0; }
   [[nodiscard]] const TravelCost& cost() const { return *cost_; }
   [[nodiscard]] bool lazy_rises() const { return options_.lazy_rises; }
+  // Lazy rises: binds the metric to the one planner that settles it (planner/settled_replan.hpp).
+  // False when another planner is bound already.
+  bool bind_settler(const void* planner) {
+    if (settler_ == nullptr) settler_ = planner;
+    return settler_ == planner;
+  }
 
   // The cost overlay behind `cost` changed these edges' conditions or these nodes' delays:
   // re-derive what they reach (lazy rises: only what got cheaper). Appends the ids of arcs whose
@@ -72,7 +81,7 @@ class CchMetric {
   // Makes arc `arc`'s weight in one direction exact, and returns it: the witnesses it unpacks
   // through are settled first, bottom up, and a weight below the cost of its witness's path under
   // today's inputs is re-derived from its triangles until the two agree. A lower bound that agrees
-  // with the cost of a real path is the cheapest. Appends the arcs it raised to `raised`. Does
+  // with the cost of a real path is the cheapest. Appends the arcs whose weight it raised to `raised`. Does
   // nothing on an eager metric, whose weights are always exact.
   double settle(std::uint32_t arc, bool upward, std::vector<std::uint32_t>& raised);
 
@@ -154,6 +163,7 @@ class CchMetric {
   std::vector<std::uint32_t> parent_;                  // by rank: the topology's parent(), in one array for the climb
   std::vector<std::uint32_t> exact_up_, exact_down_;  // by arc: the batch its weight was last found exact in
   void mark_changed(std::uint32_t arc);
+  const void* settler_ = nullptr;
 };
 
 }  // namespace corridor::planner

@@ -1,7 +1,7 @@
 // One mission's search graph on a customizable contraction hierarchy: the arcs an upward search
 // from the start and a downward search to the goal can use, with the virtual start S and goal G
 // of SearchSpace. S, and every vertex of the upward half, reaches G at its true cost over the turn
-// graph: a cheapest path goes up from the start through the elimination tree's ancestors of the
+// graph (at a lower bound of it, on a metric with lazy rises: planner/settled_replan.hpp): a cheapest path goes up from the start through the elimination tree's ancestors of the
 // start, then down through those of the goal (Dibbelt, Strasser & Wagner 2016, §6). Other
 // vertices' values are upper bounds at best: only cost_to_goal and the route are meaningful. This is D* Lite's graph at metro scale:
 // a few thousand vertices around two elimination-tree paths instead of the whole city.
@@ -43,6 +43,9 @@ class CchSearchSpace {
   CchSearchSpace(const CchMetric& metric, std::vector<EdgePoint> starts, std::vector<EdgePoint> goals);
 
   [[nodiscard]] std::size_t vertex_count() const { return n_ + 2; }
+  // The most arcs a path from S to G can take without visiting a vertex twice: S, the two halves,
+  // G. A greedy walk over stale values that goes on longer is going round in circles.
+  [[nodiscard]] std::size_t max_path_arcs() const { return up_set_.size() + down_set_.size() + 2; }
   [[nodiscard]] Vertex start() const { return Vertex{static_cast<std::uint32_t>(n_)}; }
   [[nodiscard]] Vertex goal() const { return Vertex{static_cast<std::uint32_t>(n_ + 1)}; }
   // No heuristic: the graph is small, and the key modifier never moves.

@@ -251,8 +251,9 @@ std::vector<typename BasicDStarLite<Space>::Via> BasicDStarLite<Space>::path() c
   if (cost_to_goal_s() >= kInfCost) return {};
   std::vector<Via> vias;
   Vertex u = start;
-  // Every arc costs more than zero except S arcs, so a path has at most vertex_count arcs.
-  for (std::size_t steps = 0; u != goal && steps < space_.vertex_count(); ++steps) {
+  // Every arc costs more than zero except S arcs, so a path has at most max_path_arcs arcs; a walk
+  // over stale values (before replan()) may circle, and stops there.
+  for (std::size_t steps = 0; u != goal && steps < space_.max_path_arcs(); ++steps) {
     double best = kInfCost;
     Vertex next;
     Via via{};

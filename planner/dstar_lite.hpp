@@ -72,7 +72,8 @@ class BasicDStarLite {
   [[nodiscard]] double cost_to_goal_s() const { return cut_off_ ? kInfCost : rhs(space_.start()); }
   // The current route, extracted greedily from the g values; valid after replan().
   [[nodiscard]] Route route() const { return space_.route_along(path()); }
-  // The arcs that route takes, from S to G; empty when there is none.
+  // The arcs that route takes, from S to G; empty when there is none. Before replan(), a greedy
+  // walk over the old values: some path, or none, at most max_path_arcs long.
   [[nodiscard]] std::vector<Via> path() const;
 
   [[nodiscard]] const Space& space() const { return space_; }

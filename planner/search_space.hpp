@@ -29,6 +29,8 @@ class SearchSpace {
   SearchSpace(const TravelCost& cost, std::vector<EdgePoint> starts, std::vector<EdgePoint> goals);
 
   [[nodiscard]] std::size_t vertex_count() const { return turn_vertices_ + 2; }
+  // The most arcs a path from S to G can take without visiting a vertex twice.
+  [[nodiscard]] std::size_t max_path_arcs() const { return vertex_count(); }
   [[nodiscard]] Vertex start() const { return Vertex{static_cast<std::uint32_t>(turn_vertices_)}; }
   [[nodiscard]] Vertex goal() const { return Vertex{static_cast<std::uint32_t>(turn_vertices_ + 1)}; }
   [[nodiscard]] bool is_turn_vertex(Vertex v) const { return v.index() < turn_vertices_; }

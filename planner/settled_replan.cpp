@@ -8,6 +8,9 @@ SettledReplan replan_settled(CchMetric& metric, CchDStarLite& planner) {
   if (&planner.space().metric() != &metric) {
     throw std::invalid_argument("replan_settled: the planner searches another hierarchy than the metric given");
   }
+  if (metric.lazy_rises() && !metric.bind_settler(&planner)) {
+    throw std::invalid_argument("replan_settled: a metric with lazy rises serves one planner, and another settles it");
+  }
   SettledReplan out;
   std::vector<std::uint32_t> raised;
   // Settles the hierarchy arcs of `path`; true when one was raised (then reported to the planner).
@@ -25,8 +28,9 @@ SettledReplan replan_settled(CchMetric& metric, CchDStarLite& planner) {
     planner.arcs_changed(raised);
     return true;
   };
-  // The route held before this batch is the likeliest to meet its rises (updates gather on main
-  // roads): settled first, it costs no repair round of its own.
+  // The route along the values from before this batch (a greedy walk from the moved start) is the
+  // likeliest to meet its rises (updates gather on main roads): settled first, it costs no repair
+  // round of its own.
   if (metric.lazy_rises()) (void)settle_path(planner.path());
   std::vector<CchVia> path;
   for (;;) {

@@ -78,16 +78,17 @@ TEST(DStarLite, InitialPlanMatchesDijkstraOnRandomGraphs) {
 // replan. On the turn graph (eager and lazy raises), and on a contraction hierarchy, whose metric
 // is customized with each batch and checked against its own invariants; on a metric with lazy
 // rises too, where the replan settles the arcs its routes take (replan_settled).
-enum class Variant { eager, lazy, cch, cch_lazy, cch_settled };
+enum class Variant { eager, lazy, cch, cch_lazy, cch_settled, cch_settled_lazy };
 
 // One D* Lite of either kind, fed the same reports.
 class AnyDStarLite {
  public:
   AnyDStarLite(Variant v, const TravelCost& cost, std::vector<EdgePoint> starts, std::vector<EdgePoint> goals) {
-    if (v == Variant::cch || v == Variant::cch_lazy || v == Variant::cch_settled) {
+    if (v == Variant::cch || v == Variant::cch_lazy || v == Variant::cch_settled || v == Variant::cch_settled_lazy) {
       topology_.emplace(cost.graph().turns());
-      metric_.emplace(*topology_, cost, CchMetricOptions{v == Variant::cch_settled});
-      cch_.emplace(*metric_, std::move(starts), std::move(goals), DStarLiteOptions{v == Variant::cch_lazy});
+      metric_.emplace(*topology_, cost, CchMetricOptions{v == Variant::cch_settled || v == Variant::cch_settled_lazy});
+      cch_.emplace(*metric_, std::move(starts), std::move(goals),
+                   DStarLiteOptions{v == Variant::cch_lazy || v == Variant::cch_settled_lazy});
     } else {
       flat_.emplace(cost, std::move(starts), std::move(goals), DStarLiteOptions{v == Variant::lazy});
     }
@@ -108,9 +109,16 @@ class AnyDStarLite {
   }
   ReplanStats replan() {
     if (!cch_) return flat_->replan();
-    return metric_->lazy_rises() ? replan_settled(*metric_, *cch_).stats : cch_->replan();
+    if (!metric_->lazy_rises()) return cch_->replan();
+    SettledReplan r = replan_settled(*metric_, *cch_);
+    settled_route_ = std::move(r.route);
+    return r.stats;
   }
-  [[nodiscard]] Route route() const { return cch_ ? cch_->route() : flat_->route(); }
+  // On a lazy metric, the route replan_settled handed back (what its callers use).
+  [[nodiscard]] Route route() const {
+    if (settled_route_) return *settled_route_;
+    return cch_ ? cch_->route() : flat_->route();
+  }
   [[nodiscard]] double cost_to_goal_s() const { return cch_ ? cch_->cost_to_goal_s() : flat_->cost_to_goal_s(); }
   [[nodiscard]] std::string invariant_violation() const {
     if (!cch_) return flat_->invariant_violation();
@@ -123,6 +131,7 @@ class AnyDStarLite {
   std::optional<CchTopology> topology_;
   std::optional<CchMetric> metric_;
   std::optional<CchDStarLite> cch_;
+  std::optional<Route> settled_route_;
 };
 
 class DStarLiteRepair : public ::testing::TestWithParam<Variant> {};
@@ -201,13 +210,14 @@ TEST_P(DStarLiteRepair, ReplanMatchesDijkstraAfterRandomUpdateSequences) {
 
 INSTANTIATE_TEST_SUITE_P(EagerLazyAndCch, DStarLiteRepair,
                          ::testing::Values(Variant::eager, Variant::lazy, Variant::cch, Variant::cch_lazy,
-                                           Variant::cch_settled),
+                                           Variant::cch_settled, Variant::cch_settled_lazy),
                          [](const ::testing::TestParamInfo<Variant>& p) {
                            switch (p.param) {
                              case Variant::lazy: return "lazy";
                              case Variant::cch: return "cch";
                              case Variant::cch_lazy: return "cch_lazy";
                              case Variant::cch_settled: return "cch_settled";
+                             case Variant::cch_settled_lazy: return "cch_settled_lazy";
                              default: return "eager";
                            }
                          });
