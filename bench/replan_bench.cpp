@@ -115,6 +115,10 @@ class UpdateGenerator {
   std::vector<EdgeId> congested_;  // may hold duplicates; clearing an edge twice is harmless
 };
 
+double mean_of(const std::vector<double>& xs) {
+  return xs.empty() ? 0.0 : std::accumulate(xs.begin(), xs.end(), 0.0) / static_cast<double>(xs.size());
+}
+
 }  // namespace
 
 void write_samples_csv(std::ostream& out, const std::vector<ReplanSample>& samples) {
@@ -363,8 +367,7 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
   const double n = res.replans > 0 ? static_cast<double>(res.replans) : 1.0;
   res.dstar_mean_expanded = expanded / n;
   // A trip's planner at its end: what a mission that drove that trip holds.
-  res.dstar_bytes_per_planner = planner_bytes.empty() ? 0.0 : std::accumulate(planner_bytes.begin(), planner_bytes.end(), 0.0) /
-                                                                  static_cast<double>(planner_bytes.size());
+  res.dstar_bytes_per_planner = mean_of(planner_bytes);
   res.dstar_max_bytes_per_planner = planner_bytes.empty() ? 0.0 : *std::max_element(planner_bytes.begin(), planner_bytes.end());
   res.dstar_mean_rekeyed = rekeyed / n;
   res.dstar_mean_raised = raised / n;
@@ -379,8 +382,7 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
   res.cch_mean_changed_arcs = cch_changed / n;
   res.cch_mean_expanded = cch_expanded / n;
   res.cch_mean_vertices = cch_vertices / n;
-  res.cch_bytes_per_planner =
-      cch_bytes.empty() ? 0.0 : std::accumulate(cch_bytes.begin(), cch_bytes.end(), 0.0) / static_cast<double>(cch_bytes.size());
+  res.cch_bytes_per_planner = mean_of(cch_bytes);
   res.cch_max_bytes_per_planner = cch_bytes.empty() ? 0.0 : *std::max_element(cch_bytes.begin(), cch_bytes.end());
   res.lazy_dstar = summarize_ms(t_lazy);
   res.lazy_customization = summarize_ms(t_lazy_custom);
@@ -389,8 +391,7 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
   res.lazy_mean_changed_arcs = lazy_changed / n;
   res.lazy_mean_repairs = lazy_repairs / n;
   res.lazy_mean_settled = lazy_settled / n;
-  res.lazy_bytes_per_planner =
-      lazy_bytes.empty() ? 0.0 : std::accumulate(lazy_bytes.begin(), lazy_bytes.end(), 0.0) / static_cast<double>(lazy_bytes.size());
+  res.lazy_bytes_per_planner = mean_of(lazy_bytes);
   return res;
 }
 

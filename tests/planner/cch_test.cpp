@@ -29,6 +29,30 @@ struct GridHierarchy {
   CchMetric metric;
 };
 
+// A batch of congestion: `count` random edges closed, cleared or slowed by ×1–5 with a queue, and
+// now and then a node's delay; appended to `edges` and `nodes`.
+void random_batch(const maps::RoadGraph& g, CostOverlay& overlay, std::mt19937_64& rng, int count, std::vector<EdgeId>& edges,
+                  std::vector<NodeId>& nodes) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int k = 0; k < count; ++k) {
+    const EdgeId e = testing::random_point(g, rng).edge;
+    const double r = unit(rng);
+    if (r < 0.1) {
+      overlay.close_edge(e);
+    } else if (r < 0.45) {
+      overlay.reset_edge(e);
+    } else {
+      overlay.set_edge(e, {1.0 + unit(rng) * 4.0, unit(rng) < 0.5 ? unit(rng) * 60.0 : 0.0});
+    }
+    edges.push_back(e);
+  }
+  if (unit(rng) < 0.3) {
+    const NodeId n{std::uniform_int_distribution<std::uint32_t>(0, static_cast<std::uint32_t>(g.node_count() - 1))(rng)};
+    overlay.set_node_delay(n, unit(rng) < 0.5 ? 0.0 : unit(rng) * 30.0);
+    nodes.push_back(n);
+  }
+}
+
 // The contraction is a chordal supergraph of the turn graph: every turn has an arc, the higher
 // neighbours of a vertex are pairwise joined, and they all lie on its elimination-tree path.
 TEST(CchTopology, ContractionIsChordalAndHoldsEveryTurn) {
@@ -96,23 +120,7 @@ TEST(CchMetric, PartialCustomizationEqualsFullCustomization) {
         for (EdgeId e : closed_at_start) overlay.reset_edge(e);
         edges = closed_at_start;
       }
-      for (int k = 0; k < 5; ++k) {
-        const EdgeId e = testing::random_point(g, rng).edge;
-        const double r = unit(rng);
-        if (r < 0.1) {
-          overlay.close_edge(e);
-        } else if (r < 0.45) {
-          overlay.reset_edge(e);
-        } else {
-          overlay.set_edge(e, {1.0 + unit(rng) * 4.0, unit(rng) < 0.5 ? unit(rng) * 60.0 : 0.0});
-        }
-        edges.push_back(e);
-      }
-      if (unit(rng) < 0.3) {
-        const NodeId n{std::uniform_int_distribution<std::uint32_t>(0, static_cast<std::uint32_t>(g.node_count() - 1))(rng)};
-        overlay.set_node_delay(n, unit(rng) < 0.5 ? 0.0 : unit(rng) * 30.0);
-        nodes.push_back(n);
-      }
+      random_batch(g, overlay, rng, 5, edges, nodes);
       std::vector<std::uint32_t> changed, changed_by_nodes;
       metric.edges_changed(edges, changed);
       metric.nodes_changed(nodes, changed_by_nodes);
@@ -151,24 +159,8 @@ TEST(CchMetric, LazyRisesSettleToTheFullCustomization) {
     std::uniform_int_distribution<std::uint32_t> any_arc(0, static_cast<std::uint32_t>(t.arc_count() - 1));
     for (int batch = 0; batch < 30; ++batch) {
       std::vector<EdgeId> edges;
-      for (int k = 0; k < 4; ++k) {
-        const EdgeId e = testing::random_point(g, rng).edge;
-        const double r = unit(rng);
-        if (r < 0.1) {
-          overlay.close_edge(e);
-        } else if (r < 0.45) {
-          overlay.reset_edge(e);
-        } else {
-          overlay.set_edge(e, {1.0 + unit(rng) * 4.0, unit(rng) < 0.5 ? unit(rng) * 60.0 : 0.0});
-        }
-        edges.push_back(e);
-      }
       std::vector<NodeId> nodes;
-      if (unit(rng) < 0.3) {
-        const NodeId n{std::uniform_int_distribution<std::uint32_t>(0, static_cast<std::uint32_t>(g.node_count() - 1))(rng)};
-        overlay.set_node_delay(n, unit(rng) < 0.5 ? 0.0 : unit(rng) * 30.0);
-        nodes.push_back(n);
-      }
+      random_batch(g, overlay, rng, 4, edges, nodes);
       std::vector<std::uint32_t> changed;
       lazy.edges_changed(edges, changed);
       lazy.nodes_changed(nodes, changed);
