@@ -359,8 +359,9 @@ double CchMetric::settle(std::uint32_t arc, bool upward, std::vector<std::uint32
   if (!options_.lazy_rises) return upward ? up_[arc] : down_[arc];
   const CchTopology& t = *topology_;
   // Every weight is at most its triangles' sums and its input (a fall is carried up at once, a
-  // rise only raises them), and so at most its true value. Each round either ends or moves the witness to another triangle
-  // of lower-bound sum; sums only rise as witnesses settle, so the rounds end.
+  // rise only raises them), and so at most its true value. Each round either ends or moves the
+  // witness to another triangle of lower-bound sum; sums only rise as witnesses settle, so the
+  // rounds end.
   std::uint32_t& exact = upward ? exact_up_[arc] : exact_down_[arc];
   if (exact >= changed_below_[t.tail(arc)]) return upward ? up_[arc] : down_[arc];
   for (;;) {

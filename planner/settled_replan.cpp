@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 namespace corridor::planner {
+
 SettledReplan replan_settled(CchMetric& metric, CchDStarLite& planner) {
   if (&planner.space().metric() != &metric) {
     throw std::invalid_argument("replan_settled: the planner searches another hierarchy than the metric given");
