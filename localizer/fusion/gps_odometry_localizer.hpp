@@ -1,9 +1,12 @@
 // The localizer's one entry point per sensor: GPS fixes and odometry increments in, positions on
 // the road graph out. As in the seed, GPS is followed while its HDOP is at most 10, through the
 // online HMM matcher; when the HDOP is worse or fixes stop coming, odometry takes over from the
-// last good matched fix and heading and is kept on the map (OdometryMapMatcher). Handing over to
-// odometry continues from the last GPS point, so the position does not jump; handing back to GPS
-// moves it by the drift the odometry accumulated, which the output's sigma_m said to expect.
+// last good fixes and heading and is kept on the map (OdometryMapMatcher). It restarts at every
+// good fix from where the recent fixes, carried by the odometry, put the vehicle; a fix that
+// disagrees with them (multipath) is shown but not restarted from. Handing over to odometry
+// continues from there, so the position does not jump beyond the last fix's own error; handing
+// back to GPS moves it by the drift the odometry accumulated, which the output's sigma_m said to
+// expect.
 #pragma once
 
 #include <deque>
@@ -18,13 +21,28 @@ struct LocalizerConfig {
   HmmConfig hmm;
   OdometryMatchConfig odometry;
   double max_gps_hdop = 10.0;   // the seed's switch
-  double gps_timeout_s = 2.5;   // no good fix for this long: odometry
+  double gps_timeout_s = 2.5;   // no good fix for this long: odometry...
+  // ...or for this many of the fixes' own intervals, if sooner: a 1 Hz receiver that misses one
+  // fix has gone quiet, and holding its last position for 2.5 s leaves a vehicle at 30 m/s 75 m
+  // behind.
+  double gps_overdue_intervals = 1.5;
   double course_memory_m = 300.0;  // a remembered course counts until the odometry has driven this far
   // Along the road, GPS is averaged over the last fixes, each carried forward by the odometry
   // driven since (a stopped vehicle's fixes scatter along its road by σ; their mean by σ/√n).
   std::size_t along_fixes = 10;
   double along_drift_per_m = 0.01;  // the odometry's 1σ per metre carried...
   double along_max_carry_m = 150.0;  // ...and no further than this
+  // Where the odometry restarts: the recent fixes, each carried to now by the odometry, averaged
+  // (a fix's error is its own; the mean's shrinks as √n, so a parallel road a lane or two away
+  // is told apart). Each carried fix's 1σ: its own, the along-road drift, and a course error of
+  // about 6° (0.1 m across per metre carried). A fix further than restart_gate_sigmas from the
+  // mean (an innovation gate) is shown but not averaged: a multipath fix 60 m off that the online
+  // match followed would otherwise be where the odometry starts if GPS then goes quiet. A gated
+  // fix that agrees with the gated fix before it starts the mean afresh: two fixes in a row that
+  // agree with each other say the mean was wrong.
+  std::size_t restart_fixes = 10;
+  double restart_gate_sigmas = 3.0;
+  double carry_course_per_m = 0.1;
 };
 
 enum class PositionSource { none, gps, odometry };
@@ -60,6 +78,8 @@ class GpsOdometryLocalizer {
   HmmMatcher hmm_;
   OdometryMapMatcher odometry_;
   double last_good_gps_s_ = -1e18;
+  double fix_interval_s_ = 0;  // between good fixes, smoothed (0: not seen yet)
+  [[nodiscard]] double takeover_s() const;
   // The last course over ground seen while moving, turned since by the odometry: a vehicle that
   // stopped keeps facing the way it drove, though the road alone cannot say which way that was.
   std::optional<double> course_deg_;
@@ -74,6 +94,25 @@ class GpsOdometryLocalizer {
     double time_s = 0;
   };
   std::deque<RecentFix> recent_;
+  // A fix in the local frame with its 1σ, and the dead reckoning since.
+  struct CarriedFix {
+    maps::Point2 point;
+    double sigma_m = 0;
+    double driven_m = 0;
+    maps::Point2 moved;       // along the course...
+    bool course_known = true;  // ...when it was known all the way
+  };
+  struct FixMean {
+    bool valid = false;
+    maps::Point2 point;
+    double sigma_m = 0;
+  };
+  std::deque<CarriedFix> carried_;   // the fixes the odometry restarts from, oldest first
+  std::optional<CarriedFix> gated_;  // the last fix, if it failed the gate
+  [[nodiscard]] FixMean fix_mean() const;
+  [[nodiscard]] bool agrees(const FixMean& mean, maps::Point2 fix, double sigma_m) const;
+  [[nodiscard]] FixMean carried_to_now(const CarriedFix& f) const;
+  void dead_reckon(CarriedFix& f, double distance_m) const;
   LocalizedPoint last_;
 };
 

@@ -85,8 +85,9 @@ void OdometryMapMatcher::seed() {
     h.cost = 0.5 * std::pow(distance_m / sigma, 2.0) + 0.5 * std::pow(against / heading_sigma, 2.0);
     hyps_.push_back(h);
   };
-  add(start_.edge, start_.offset_m, 0.0);
-  if (const EdgeId twin = graph_.twin(start_.edge); twin.valid()) add(twin, graph_.twin_offset_m(start_.edge, start_.offset_m), 0.0);
+  const double matched_off = maps::distance_m(graph_.point_along(start_.edge, start_.offset_m), start_.point);
+  add(start_.edge, start_.offset_m, matched_off);
+  if (const EdgeId twin = graph_.twin(start_.edge); twin.valid()) add(twin, graph_.twin_offset_m(start_.edge, start_.offset_m), matched_off);
   if (snapper_ != nullptr) {
     const double radius = std::max(config_.start_radius_m, 2.0 * sigma);
     for (const maps::SnapResult& c : snapper_->candidates_local(start_.point, radius, 8)) {

@@ -85,7 +85,8 @@ struct OdometryMatchConfig {
 struct OdometryStart {
   EdgeId edge;              // the matched edge...
   double offset_m = 0;      // ...and offset
-  maps::Point2 point;       // the matched point (the dead reckoning's origin)
+  maps::Point2 point;       // the dead reckoning's origin: the matched point, or where the recent
+                            // fixes put the vehicle (then the matched edge pays for its distance)
   double heading_deg = 0;   // the vehicle's heading there...
   double heading_sigma_deg = 20.0;  // ...and its 1σ (a receiver's course: small; a road's bearing alone: large)
   double time_s = 0;

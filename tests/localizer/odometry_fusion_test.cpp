@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <vector>
 
 #include "localizer/fusion/gps_odometry_localizer.hpp"
 #include "localizer/study/localization_study.hpp"
@@ -305,6 +306,112 @@ TEST_F(LocalizerOnCrossroads, AveragesAStoppedVehiclesFixesAlongTheRoad) {
   }
   ASSERT_EQ(p.source, PositionSource::gps);
   EXPECT_LT(std::abs(p.match.point.x_m - (-100.0)), 2.0);  // the last fix alone is 6 m off
+}
+
+// Parallel east-west roads, 800 m long, at the given y (the first at 0), joined by a short
+// north-south street at x = link_x: the online match can cross between them there.
+maps::RoadGraph parallel_roads(const std::vector<double>& ys, double link_x) {
+  Sketch s;
+  std::vector<std::uint32_t> link;
+  for (std::size_t i = 0; i < ys.size(); ++i) {
+    const auto first = static_cast<std::uint32_t>(s.nodes.size());
+    s.nodes.insert(s.nodes.end(), {{-400, ys[i]}, {link_x, ys[i]}, {400, ys[i]}});
+    s.roads.push_back({{first, first + 1, first + 2}, false, static_cast<std::int64_t>(i + 1)});
+    link.push_back(first + 1);
+  }
+  s.roads.push_back({link, false, 99});
+  return s.build();
+}
+
+// Eastbound at 10 m/s on the road y = 0, with odometry each second; fix t at (x0 + 10 t, y(t)).
+struct ParallelDrive {
+  maps::RoadGraph g;
+  maps::EdgeSnapper snapper{g};
+  GpsOdometryLocalizer loc{g, snapper};
+  ParallelDrive(const std::vector<double>& ys, double link_x) : g(parallel_roads(ys, link_x)) {}
+  LocalizedPoint fix(int t, double y) {
+    if (t > 0) loc.on_odometry({static_cast<double>(t), 10.0, 0.0});
+    GpsFix f;
+    f.time_s = t;
+    f.position = g.projection().to_lat_lon({-300.0 + 10.0 * t, y});
+    f.hdop = 1.0;
+    f.heading_deg = 90.0;
+    f.speed_mps = 10.0;
+    return loc.on_gps(f);
+  }
+  LocalizedPoint outage(int from_t, int to_t) {
+    LocalizedPoint p;
+    for (int t = from_t; t <= to_t; ++t) p = loc.on_odometry({static_cast<double>(t), 10.0, 0.0});
+    return p;
+  }
+};
+
+// The last fix before GPS goes quiet is a multipath jump onto a road 60 m off, and the online
+// match follows it (nothing after it says otherwise). The odometry does not restart from it: it
+// fails the gate against the fixes before it, carried by the odometry, so the outage is driven on
+// the true road. Averaged in, it would pull the start 5 m north, nearer a street 12 m away.
+TEST(GpsOdometryLocalizer, AMultipathFixJustBeforeAnOutageIsNotWhereTheOdometryStarts) {
+  ParallelDrive d({0.0, 12.0, 60.0}, -205.0);
+  for (int t = 0; t < 10; ++t) d.fix(t, 0.0);
+  const LocalizedPoint jumped = d.fix(10, 60.0);
+  ASSERT_EQ(jumped.source, PositionSource::gps);
+  EXPECT_GT(jumped.match.point.y_m, 50.0);  // shown as GPS gave it...
+  const LocalizedPoint p = d.outage(11, 20);
+  ASSERT_EQ(p.source, PositionSource::odometry);
+  EXPECT_LT(std::abs(p.match.point.y_m), 1.0);  // ...but the odometry drives on the true road
+  EXPECT_NEAR(p.match.point.x_m, -300.0 + 10.0 * 20, 5.0);
+}
+
+// The fixes move to the other road and stay there (the vehicle is there; the earlier fixes were
+// wrong): the first is gated, the second agrees with it, and the odometry restarts from them.
+TEST(GpsOdometryLocalizer, TwoFixesThatAgreeOverruleTheFixesBeforeThem) {
+  ParallelDrive d({0.0, 60.0}, -205.0);
+  for (int t = 0; t < 10; ++t) d.fix(t, 1.0);
+  d.fix(10, 60.0);
+  d.fix(11, 61.0);
+  const LocalizedPoint p = d.outage(12, 20);
+  ASSERT_EQ(p.source, PositionSource::odometry);
+  EXPECT_NEAR(p.match.point.y_m, 60.0, 1.0);
+}
+
+// Two roads 14 m apart. The fixes scatter around the road y = 0 (σ 4 m), and the last one, 11 m
+// north, is nearer the other road: the online match takes that one. The odometry starts from the
+// fixes' mean, carried by the odometry, not from the last match, and drives the outage on y = 0.
+TEST(GpsOdometryLocalizer, TheOdometryStartsFromTheFixesMeanNotTheLastMatch) {
+  ParallelDrive d({0.0, 14.0}, -212.0);
+  const double y[] = {3.0, -4.0, 2.0, -3.0, 4.0, -2.0, 3.0, -4.0, 1.0, 11.0};
+  LocalizedPoint last;
+  for (int t = 0; t < 10; ++t) last = d.fix(t, y[t]);
+  ASSERT_GT(last.match.point.y_m, 13.0);  // the online match is on the other road
+  const LocalizedPoint p = d.outage(10, 16);
+  ASSERT_EQ(p.source, PositionSource::odometry);
+  EXPECT_LT(std::abs(p.match.point.y_m), 1.0);
+}
+
+// A 1 Hz receiver, odometry at 10 Hz. When a fix does not come, the odometry takes over once one
+// and a half of the fixes' intervals have passed (not after the 2.5 s timeout): the position
+// moves on instead of standing at the last fix while the vehicle drives away from it.
+TEST_F(LocalizerOnCrossroads, AnOverdueFixHandsOverToTheOdometrySoonerThanTheTimeout) {
+  double x = -250.0;
+  for (int k = 0; k <= 100; ++k) {
+    const double t = 0.1 * k;
+    if (k > 0) {
+      x += 1.0;
+      p = loc.on_odometry({t, 1.0, 0.0});
+    }
+    if (k % 10 == 0) {
+      GpsFix f = fix_at(g, t, x, 1.0);
+      f.heading_deg = 90.0;
+      f.speed_mps = 10.0;
+      p = loc.on_gps(f);
+    }
+  }
+  ASSERT_EQ(p.source, PositionSource::gps);  // the last fix, at t = 10 s
+  for (int k = 101; k <= 114; ++k) p = loc.on_odometry({0.1 * k, 1.0, 0.0});
+  EXPECT_EQ(p.source, PositionSource::gps) << "1.4 s after the fix: it may still come";
+  for (int k = 115; k <= 120; ++k) p = loc.on_odometry({0.1 * k, 1.0, 0.0});
+  ASSERT_EQ(p.source, PositionSource::odometry) << "2 s after it: overdue";
+  EXPECT_NEAR(p.match.point.x_m, x + 20.0, 3.0);
 }
 
 TEST(LocalizationStudy, ReadsTheOsmWayOfASumoLane) {
