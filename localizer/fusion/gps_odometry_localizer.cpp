@@ -2,6 +2,8 @@
 
 #include "localizer/match/bearing.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -101,14 +103,16 @@ GpsOdometryLocalizer::FixMean GpsOdometryLocalizer::carried_to_now(const Carried
 
 GpsOdometryLocalizer::FixMean GpsOdometryLocalizer::fix_mean() const {
   double x = 0.0, y = 0.0, weights = 0.0;
+  int counted = 0;
   for (const CarriedFix& f : carried_) {
     const FixMean c = carried_to_now(f);
     if (!c.valid) continue;
+    ++counted;
     const double w = 1.0 / std::max(0.25, c.sigma_m * c.sigma_m);
     x += w * c.point.x_m, y += w * c.point.y_m, weights += w;
   }
   FixMean out;
-  if (!(weights > 0.0)) return out;
+  if (!(weights > 0.0) || counted < 2) return out;
   out.valid = true;
   out.point = {x / weights, y / weights};
   out.sigma_m = 1.0 / std::sqrt(weights);
@@ -120,19 +124,28 @@ bool GpsOdometryLocalizer::agrees(const FixMean& mean, maps::Point2 fix, double 
   return maps::distance_m(fix, mean.point) <= config_.restart_gate_sigmas * sigma;
 }
 
-void GpsOdometryLocalizer::dead_reckon(CarriedFix& f, double distance_m) const {
+void GpsOdometryLocalizer::dead_reckon(CarriedFix& f, double distance_m, std::optional<double> course_deg) {
   if (distance_m <= 0.0) return;
   f.driven_m += distance_m;
-  if (!course_deg_) {
+  if (!course_deg) {
     f.course_known = false;
     return;
   }
-  const double rad = *course_deg_ * std::numbers::pi / 180.0;  // clockwise from north; x east, y north
+  const double rad = *course_deg * std::numbers::pi / 180.0;  // clockwise from north; x east, y north
   f.moved.x_m += distance_m * std::sin(rad);
   f.moved.y_m += distance_m * std::cos(rad);
 }
 
 LocalizedPoint GpsOdometryLocalizer::on_gps(const GpsFix& fix) {
+  // The receiver's interval, from every fix it gives, whatever its quality.
+  const double previous_fix_s = last_fix_s_;
+  if (std::isfinite(fix.time_s) && fix.time_s > last_fix_s_) {
+    if (const double gap = fix.time_s - last_fix_s_; gap <= config_.gps_timeout_s) {
+      fix_gaps_.push_back(gap);
+      if (fix_gaps_.size() > 5) fix_gaps_.pop_front();
+    }
+    last_fix_s_ = fix.time_s;
+  }
   if (fix.hdop && *fix.hdop > config_.max_gps_hdop) {
     // Not followed (the seed's switch), but a poor fix still tells the odometry's hypotheses apart
     // when they are streets apart.
@@ -144,37 +157,42 @@ LocalizedPoint GpsOdometryLocalizer::on_gps(const GpsFix& fix) {
   const MatchedPoint matched = hmm_.update(fix);
   if (!matched.matched) return last_;
   const double sigma = usable_hdop(fix, config_.hmm.default_hdop) * config_.hmm.sigma_base_m;
-  // The mean and its gate only where the odometry has been carrying the vehicle; a GPS-only
-  // trace has nothing to carry a fix with.
+  // The fixes are carried only by the odometry: on a GPS-only trace, or after a gap in the fixes,
+  // the mean starts again (and with one fix, the restart is the matched point). Gated fixes are
+  // no gap: the mean's 1σ grows with the metres carried, and with it the gate.
   const bool carried_by_odometry = fix.time_s - last_odometry_s_ <= config_.gps_timeout_s;
-  if (!carried_by_odometry || (!carried_.empty() && fix.time_s - last_good_gps_s_ > config_.gps_timeout_s)) carried_.clear();
+  if (!carried_by_odometry || fix.time_s - previous_fix_s > config_.gps_timeout_s) carried_.clear();
   CarriedFix now;
   now.point = graph_.projection().to_local(fix.position);
   now.sigma_m = sigma;
   if (const FixMean before = fix_mean(); before.valid && !agrees(before, now.point, sigma)) {
     const FixMean gated = gated_ ? carried_to_now(*gated_) : FixMean{};
     if (!gated.valid || !agrees(gated, now.point, sigma)) {
-      // Shown, as GPS is followed, but the odometry keeps its restart and its record since, and
-      // takes over from there if no agreeing fix comes.
+      // Shown, as GPS is followed, with its distance from the mean as its 1σ, but the odometry
+      // keeps its restart and its record since, and takes over from there if no agreeing fix
+      // comes.
       gated_ = now;
-      LocalizedPoint p = output(PositionSource::gps, matched, sigma);
+      // Once the odometry has taken over (gated fixes only, for 1.5 intervals), it stays the
+      // output: a position flipping between it and each gated fix would help no one.
+      if (last_.source == PositionSource::odometry) return last_;
+      LocalizedPoint p = output(PositionSource::gps, matched, std::max(sigma, maps::distance_m(now.point, before.point)));
       if (fix.speed_mps) p.speed_mps = last_.speed_mps = *fix.speed_mps;
       return p;
     }
     carried_.assign(1, *gated_);
   }
   gated_.reset();
-  carried_.push_back(now);
-  while (carried_.size() > config_.restart_fixes) carried_.pop_front();
-  if (const double gap = fix.time_s - last_good_gps_s_; gap > 0.0 && gap <= config_.gps_timeout_s) {
-    fix_interval_s_ = fix_interval_s_ > 0.0 ? 0.8 * fix_interval_s_ + 0.2 * gap : gap;
+  // A repeated or older time is not a new fix of the present: it would count twice.
+  if (fix.time_s > last_good_gps_s_) {
+    carried_.push_back(now);
+    while (carried_.size() > config_.restart_fixes) carried_.pop_front();
   }
-  last_good_gps_s_ = fix.time_s;
+  last_good_gps_s_ = std::max(last_good_gps_s_, fix.time_s);
   const MatchedPoint m = along_road_mean(matched, sigma, fix.time_s);
-  // Odometry always restarts from the latest good fix, so a hand-over continues from it. Its
-  // heading is the receiver's last course while moving, turned by the odometry since (the online
-  // match's direction can be wrong at the last fix, and a stopped vehicle has no course); without
-  // one, it is the road's, and only loosely known.
+  // Odometry restarts at every good fix, so a hand-over continues from the latest. Its heading is
+  // the receiver's last course while moving, turned by the odometry since (the online match's
+  // direction can be wrong at the last fix, and a stopped vehicle has no course); without one, it
+  // is the road's, and only loosely known.
   OdometryStart from;
   from.edge = m.edge;
   from.offset_m = m.offset_m;
@@ -196,7 +214,7 @@ LocalizedPoint GpsOdometryLocalizer::on_gps(const GpsFix& fix) {
   from.time_s = fix.time_s;
   // The start's 1σ stays the fix's: the mean's own (a few metres) would pin the dead reckoning
   // to a point that a course error over the carried metres can shift as far (measured: Monaco
-  // loses 1.5 points of the outage at σ 10–15 m with it).
+  // lost 1.5 points of the outage at σ 10–15 m with it).
   from.sigma_m = sigma;
   odometry_.start(from);
   LocalizedPoint p = output(PositionSource::gps, m, sigma);
@@ -205,20 +223,31 @@ LocalizedPoint GpsOdometryLocalizer::on_gps(const GpsFix& fix) {
 }
 
 double GpsOdometryLocalizer::takeover_s() const {
-  if (!(fix_interval_s_ > 0.0)) return config_.gps_timeout_s;
-  return std::min(config_.gps_timeout_s, config_.gps_overdue_intervals * fix_interval_s_);
+  if (fix_gaps_.size() < 3) return config_.gps_timeout_s;
+  // The median: a missed fix or a burst at lock does not move it.
+  std::array<double, 5> gaps{};
+  std::copy(fix_gaps_.begin(), fix_gaps_.end(), gaps.begin());
+  const auto mid = gaps.begin() + static_cast<std::ptrdiff_t>(fix_gaps_.size() / 2);
+  std::nth_element(gaps.begin(), mid, gaps.begin() + static_cast<std::ptrdiff_t>(fix_gaps_.size()));
+  return std::clamp(config_.gps_overdue_intervals * *mid, config_.gps_min_takeover_s, config_.gps_timeout_s);
 }
 
 LocalizedPoint GpsOdometryLocalizer::on_odometry(const OdometryStep& step) {
   if (std::isfinite(step.distance_m)) odometry_m_ += std::max(0.0, step.distance_m);
   if (std::isfinite(step.time_s)) last_odometry_s_ = step.time_s;
+  if (std::isfinite(step.distance_m)) {
+    // The fixes are carried along the course at the step's middle (a 45° step at 8 m/s would put
+    // them 3 m aside with the heading at either end); a course older than course_memory_m is none.
+    std::optional<double> course;
+    if (course_deg_ && driven_since_course_m_ <= config_.course_memory_m) {
+      course = wrap180(*course_deg_ + 0.5 * (std::isfinite(step.heading_change_deg) ? step.heading_change_deg : 0.0));
+    }
+    for (CarriedFix& f : carried_) dead_reckon(f, std::max(0.0, step.distance_m), course);
+    if (gated_) dead_reckon(*gated_, std::max(0.0, step.distance_m), course);
+  }
   if (course_deg_ && std::isfinite(step.heading_change_deg) && std::isfinite(step.distance_m)) {
     course_deg_ = wrap180(*course_deg_ + step.heading_change_deg);
     driven_since_course_m_ += std::max(0.0, step.distance_m);
-  }
-  if (std::isfinite(step.distance_m)) {
-    for (CarriedFix& f : carried_) dead_reckon(f, std::max(0.0, step.distance_m));
-    if (gated_) dead_reckon(*gated_, std::max(0.0, step.distance_m));
   }
   if (!odometry_.started()) return last_;
   // Recorded from the last good fix on (each fix restarts it), so that when GPS goes quiet the

@@ -22,24 +22,31 @@ struct LocalizerConfig {
   OdometryMatchConfig odometry;
   double max_gps_hdop = 10.0;   // the seed's switch
   double gps_timeout_s = 2.5;   // no good fix for this long: odometry...
-  // ...or for this many of the fixes' own intervals, if sooner: a 1 Hz receiver that misses one
-  // fix has gone quiet, and holding its last position for 2.5 s leaves a vehicle at 30 m/s 75 m
-  // behind.
+  // ...or for this many of the receiver's own intervals (the median of its last gaps), if sooner,
+  // but not under gps_min_takeover_s: a 1 Hz receiver that misses one fix has gone quiet, and
+  // holding its last position for 2.5 s leaves a vehicle at 30 m/s 75 m behind. The floor keeps a
+  // fast receiver's latency from handing over between two of its fixes.
   double gps_overdue_intervals = 1.5;
+  double gps_min_takeover_s = 1.0;
   double course_memory_m = 300.0;  // a remembered course counts until the odometry has driven this far
   // Along the road, GPS is averaged over the last fixes, each carried forward by the odometry
   // driven since (a stopped vehicle's fixes scatter along its road by σ; their mean by σ/√n).
   std::size_t along_fixes = 10;
   double along_drift_per_m = 0.01;  // the odometry's 1σ per metre carried...
   double along_max_carry_m = 150.0;  // ...and no further than this
-  // Where the odometry restarts: the recent fixes, each carried to now by the odometry, averaged
-  // (a fix's error is its own; the mean's shrinks as √n, so a parallel road a lane or two away
-  // is told apart). Each carried fix's 1σ: its own, the along-road drift, and a course error of
-  // about 6° (0.1 m across per metre carried). A fix further than restart_gate_sigmas from the
-  // mean (an innovation gate) is shown but not averaged: a multipath fix 60 m off that the online
-  // match followed would otherwise be where the odometry starts if GPS then goes quiet. A gated
-  // fix that agrees with the gated fix before it starts the mean afresh: two fixes in a row that
-  // agree with each other say the mean was wrong.
+  // Where the odometry restarts: the recent fixes, each carried to now by the odometry along the
+  // receiver's course, averaged by weight. A carried fix's 1σ is its own, grown by 1 % of the
+  // metres carried and by 0.1 m per metre for the course's error (about 6°), so at 10 m/s and
+  // 1 Hz about four fixes count, and the mean is some 2× surer than one fix: a parallel road a
+  // lane or two away is told apart. Without a course (a receiver that gives none, or none for
+  // course_memory_m) a fix cannot be carried once the vehicle moves, and with fewer than two
+  // fixes to average the restart is the matched point, as the online match chose it.
+  // A fix further than restart_gate_sigmas from the mean (an innovation gate) is shown, with its
+  // distance from the mean as its 1σ (unless the odometry has taken over, which then stays the
+  // output), but not averaged and not restarted from: a multipath fix
+  // 60 m off that the online match followed would otherwise be where the odometry starts if GPS
+  // then goes quiet. A gated fix that agrees with the gated fix before it starts the mean afresh:
+  // two fixes in a row that agree with each other say the mean was wrong.
   std::size_t restart_fixes = 10;
   double restart_gate_sigmas = 3.0;
   double carry_course_per_m = 0.1;
@@ -78,7 +85,8 @@ class GpsOdometryLocalizer {
   HmmMatcher hmm_;
   OdometryMapMatcher odometry_;
   double last_good_gps_s_ = -1e18;
-  double fix_interval_s_ = 0;  // between good fixes, smoothed (0: not seen yet)
+  double last_fix_s_ = -1e18;  // the last fix of any quality, for the receiver's interval...
+  std::deque<double> fix_gaps_;  // ...its last gaps
   [[nodiscard]] double takeover_s() const;
   // The last course over ground seen while moving, turned since by the odometry: a vehicle that
   // stopped keeps facing the way it drove, though the road alone cannot say which way that was.
@@ -109,10 +117,10 @@ class GpsOdometryLocalizer {
   };
   std::deque<CarriedFix> carried_;   // the fixes the odometry restarts from, oldest first
   std::optional<CarriedFix> gated_;  // the last fix, if it failed the gate
-  [[nodiscard]] FixMean fix_mean() const;
+  [[nodiscard]] FixMean fix_mean() const;  // valid when at least two fixes count
   [[nodiscard]] bool agrees(const FixMean& mean, maps::Point2 fix, double sigma_m) const;
   [[nodiscard]] FixMean carried_to_now(const CarriedFix& f) const;
-  void dead_reckon(CarriedFix& f, double distance_m) const;
+  static void dead_reckon(CarriedFix& f, double distance_m, std::optional<double> course_deg);
   LocalizedPoint last_;
 };
 

@@ -85,6 +85,9 @@ void OdometryMapMatcher::seed() {
     h.cost = 0.5 * std::pow(distance_m / sigma, 2.0) + 0.5 * std::pow(against / heading_sigma, 2.0);
     hyps_.push_back(h);
   };
+  // The matched edge pays for its distance from the origin too, along the road as well: charging
+  // only the distance across (where the origin's foot on the road is) was no better (measured:
+  // docs/experiments/localization.md).
   const double matched_off = maps::distance_m(graph_.point_along(start_.edge, start_.offset_m), start_.point);
   add(start_.edge, start_.offset_m, matched_off);
   if (const EdgeId twin = graph_.twin(start_.edge); twin.valid()) add(twin, graph_.twin_offset_m(start_.edge, start_.offset_m), matched_off);

@@ -329,14 +329,16 @@ struct ParallelDrive {
   maps::EdgeSnapper snapper{g};
   GpsOdometryLocalizer loc{g, snapper};
   ParallelDrive(const std::vector<double>& ys, double link_x) : g(parallel_roads(ys, link_x)) {}
-  LocalizedPoint fix(int t, double y) {
+  LocalizedPoint fix(int t, double y, bool with_course = true) {
     if (t > 0) loc.on_odometry({static_cast<double>(t), 10.0, 0.0});
     GpsFix f;
     f.time_s = t;
     f.position = g.projection().to_lat_lon({-300.0 + 10.0 * t, y});
     f.hdop = 1.0;
-    f.heading_deg = 90.0;
-    f.speed_mps = 10.0;
+    if (with_course) {
+      f.heading_deg = 90.0;
+      f.speed_mps = 10.0;
+    }
     return loc.on_gps(f);
   }
   LocalizedPoint outage(int from_t, int to_t) {
@@ -349,7 +351,7 @@ struct ParallelDrive {
 // The last fix before GPS goes quiet is a multipath jump onto a road 60 m off, and the online
 // match follows it (nothing after it says otherwise). The odometry does not restart from it: it
 // fails the gate against the fixes before it, carried by the odometry, so the outage is driven on
-// the true road. Averaged in, it would pull the start 5 m north, nearer a street 12 m away.
+// the true road. Averaged in, it would pull the start 11 m north, almost onto a street 12 m away.
 TEST(GpsOdometryLocalizer, AMultipathFixJustBeforeAnOutageIsNotWhereTheOdometryStarts) {
   ParallelDrive d({0.0, 12.0, 60.0}, -205.0);
   for (int t = 0; t < 10; ++t) d.fix(t, 0.0);
@@ -374,6 +376,22 @@ TEST(GpsOdometryLocalizer, TwoFixesThatAgreeOverruleTheFixesBeforeThem) {
   EXPECT_NEAR(p.match.point.y_m, 60.0, 1.0);
 }
 
+// After ten good fixes, multipath only: fixes alternate between roads 60 m north and south,
+// every one gated. The odometry takes over 1.5 s after the last good fix and stays the output;
+// the gated fixes do not flip it back to GPS each second.
+TEST(GpsOdometryLocalizer, GatedFixesDoNotFlipTheOdometryBackToGps) {
+  ParallelDrive d({-60.0, 0.0, 60.0}, -150.0);
+  for (int t = 0; t < 10; ++t) d.fix(t, 0.0);
+  LocalizedPoint p;
+  for (int t = 10; t < 20; ++t) {
+    p = d.fix(t, t % 2 == 0 ? 60.0 : -60.0);
+    if (t >= 12) {
+      ASSERT_EQ(p.source, PositionSource::odometry) << "t = " << t;
+      EXPECT_LT(std::abs(p.match.point.y_m), 1.0) << "t = " << t;
+    }
+  }
+}
+
 // Two roads 14 m apart. The fixes scatter around the road y = 0 (σ 4 m), and the last one, 11 m
 // north, is nearer the other road: the online match takes that one. The odometry starts from the
 // fixes' mean, carried by the odometry, not from the last match, and drives the outage on y = 0.
@@ -386,6 +404,37 @@ TEST(GpsOdometryLocalizer, TheOdometryStartsFromTheFixesMeanNotTheLastMatch) {
   const LocalizedPoint p = d.outage(10, 16);
   ASSERT_EQ(p.source, PositionSource::odometry);
   EXPECT_LT(std::abs(p.match.point.y_m), 1.0);
+}
+
+// A receiver that gives no course: once the vehicle moves, its fixes cannot be carried, so there
+// is no mean, and the odometry starts from the online match (the road y = 0), not from the last
+// raw fix, which lies 7.5 m north, nearer the road 14 m away than its own.
+TEST(GpsOdometryLocalizer, WithoutACourseTheOdometryStartsFromTheMatchNotTheRawFix) {
+  ParallelDrive d({0.0, 14.0}, 100.0);
+  LocalizedPoint last;
+  for (int t = 0; t < 10; ++t) last = d.fix(t, t < 9 ? 1.0 : 7.5, false);
+  ASSERT_LT(std::abs(last.match.point.y_m), 1.0);  // the online match stays on y = 0
+  const LocalizedPoint p = d.outage(10, 16);
+  ASSERT_EQ(p.source, PositionSource::odometry);
+  EXPECT_LT(std::abs(p.match.point.y_m), 1.0);
+}
+
+// A 10 Hz receiver whose fixes arrive 0.2 s late, odometry at 20 Hz: the odometry does not take
+// over between two of its fixes (1.5 of its intervals is 0.15 s; the floor is 1 s).
+TEST_F(LocalizerOnCrossroads, AFastReceiversLatencyDoesNotHandOverBetweenItsFixes) {
+  int odometry_outputs = 0;
+  for (int k = 1; k <= 200; ++k) {
+    const double t = 0.05 * k;
+    p = loc.on_odometry({t, 0.5, 0.0});
+    if (k > 40) odometry_outputs += p.source == PositionSource::odometry ? 1 : 0;
+    if (k % 2 == 0 && k >= 4) {  // the fix of 0.2 s ago
+      GpsFix f = fix_at(g, t - 0.2, -250.0 + 10.0 * (t - 0.2), 1.0);
+      f.heading_deg = 90.0;
+      f.speed_mps = 10.0;
+      p = loc.on_gps(f);
+    }
+  }
+  EXPECT_EQ(odometry_outputs, 0);
 }
 
 // A 1 Hz receiver, odometry at 10 Hz. When a fix does not come, the odometry takes over once one
