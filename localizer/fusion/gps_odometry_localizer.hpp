@@ -43,10 +43,10 @@ struct LocalizerConfig {
   // fixes to average the restart is the matched point, as the online match chose it.
   // A fix further than restart_gate_sigmas from the mean (an innovation gate) is shown, with its
   // distance from the mean as its 1σ (unless the odometry has taken over, which then stays the
-  // output), but not averaged and not restarted from: a multipath fix
-  // 60 m off that the online match followed would otherwise be where the odometry starts if GPS
-  // then goes quiet. A gated fix that agrees with the gated fix before it starts the mean afresh:
-  // two fixes in a row that agree with each other say the mean was wrong.
+  // output), but not averaged and not restarted from: a multipath fix 60 m off that the online
+  // match followed would otherwise be where the odometry starts if GPS then goes quiet. A gated
+  // fix that agrees with the gated fix before it starts the mean afresh: two fixes in a row that
+  // agree with each other say the mean was wrong.
   std::size_t restart_fixes = 10;
   double restart_gate_sigmas = 3.0;
   double carry_course_per_m = 0.1;
