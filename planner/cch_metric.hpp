@@ -1,10 +1,10 @@
 // The metric half of a customizable contraction hierarchy: one weight per arc and direction of a
 // CchTopology, derived from a TravelCost (one vehicle profile over the live cost overlay), so that
 // every arc holds the cost of the cheapest path between its ends through lower ranks (with lazy
-// rises, below: a lower bound of it). Built by a
-// full customization; kept current by partial customization as congestion changes, which
-// re-derives only the arcs an input change can reach (Dibbelt, Strasser & Wagner 2016, §5). The
-// arcs whose weights moved are handed back, so the searches above can repair themselves.
+// rises, below: a lower bound of it). Built by a full customization; kept current by partial
+// customization as congestion changes, which re-derives only the arcs an input change can reach
+// (Dibbelt, Strasser & Wagner 2016, §5). The arcs whose weights moved are handed back, so the
+// searches above can repair themselves.
 //
 // Most arc directions of a hierarchy over a turn graph can never be driven: a turn vertex reaches
 // the next edge's vertex, rarely the way back, so on Porto 74 % of the arcs are open one way only
@@ -81,8 +81,8 @@ class CchMetric {
   // Makes arc `arc`'s weight in one direction exact, and returns it: the witnesses it unpacks
   // through are settled first, bottom up, and a weight below the cost of its witness's path under
   // today's inputs is re-derived from its triangles until the two agree. A lower bound that agrees
-  // with the cost of a real path is the cheapest. Appends the arcs whose weight it raised to `raised`. Does
-  // nothing on an eager metric, whose weights are always exact.
+  // with the cost of a real path is the cheapest. Appends the arcs whose weight it raised to
+  // `raised`. Does nothing on an eager metric, whose weights are always exact.
   double settle(std::uint32_t arc, bool upward, std::vector<std::uint32_t>& raised);
 
   // Checks every arc against its lower triangles and its input (lazy rises: that it lies at or

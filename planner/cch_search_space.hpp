@@ -1,10 +1,12 @@
 // One mission's search graph on a customizable contraction hierarchy: the arcs an upward search
-// from the start and a downward search to the goal can use, with the virtual start S and goal G
-// of SearchSpace. S, and every vertex of the upward half, reaches G at its true cost over the turn
-// graph (at a lower bound of it, on a metric with lazy rises: planner/settled_replan.hpp): a cheapest path goes up from the start through the elimination tree's ancestors of the
-// start, then down through those of the goal (Dibbelt, Strasser & Wagner 2016, §6). Other
-// vertices' values are upper bounds at best: only cost_to_goal and the route are meaningful. This is D* Lite's graph at metro scale:
-// a few thousand vertices around two elimination-tree paths instead of the whole city.
+// from the start and a downward search to the goal can use, with the virtual start S and goal G of
+// SearchSpace. S, and every vertex of the upward half, reaches G at its true cost over the turn
+// graph (at a lower bound of it, on a metric with lazy rises: planner/settled_replan.hpp): a
+// cheapest path goes up from the start through the elimination tree's ancestors of the start, then
+// down through those of the goal (Dibbelt, Strasser & Wagner 2016, §6). Other vertices' values are
+// upper bounds at best: only cost_to_goal and the route are meaningful. This is D* Lite's graph at
+// metro scale: a few thousand vertices around two elimination-tree paths instead of the whole
+// city.
 //
 // Vertices are CCH ranks (planner/cch_topology.hpp), then S, then G. The arcs:
 //   S → the start points' vertices (the rest of the start edge), and S → G on one edge;

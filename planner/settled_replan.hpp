@@ -1,7 +1,8 @@
 // D* Lite on a contraction hierarchy whose rises are lazy (CchMetricOptions::lazy_rises): the
 // repair runs on lower bounds, so the arcs of the route it finds are settled (made exact); where
-// one of them rose, the planner is told and the repair runs again. A route whose cost equals the lower bound it was found with is a cheapest one,
-// so the routes stay exact; a replan pays only for the rises its routes meet.
+// one of them rose, the planner is told and the repair runs again. A route whose cost equals the
+// lower bound it was found with is a cheapest one, so the routes stay exact; a replan pays only
+// for the rises its routes meet.
 #pragma once
 
 #include <cstdint>
