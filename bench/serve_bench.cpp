@@ -353,6 +353,9 @@ json run_serve_bench(const maps::RoadGraph& graph, const ServeBenchConfig& c) {
   // Every single mission repair the congestion caused, from the server's own histogram.
   out["congestion"]["mission_replans"] =
       histogram_from_metrics(metrics_status == 200 ? metrics_text : "", "corridor_congestion_mission_replan_seconds");
+  // The same repairs in their thread's CPU time: what the repair costs, without waiting for a core.
+  out["congestion"]["mission_replans_cpu"] =
+      histogram_from_metrics(metrics_status == 200 ? metrics_text : "", "corridor_congestion_mission_replan_cpu_seconds");
   // From the request's handling to its answer (its commit included), without the time it spent
   // in socket buffers or waiting for an I/O thread: what is the server's own, and what is queueing.
   out["positions"]["server_side"] =

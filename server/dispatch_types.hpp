@@ -119,6 +119,9 @@ struct CongestionResult {
   double slowest_replan_s = 0;
   // Each repaired mission's D* Lite repair time, in no particular order: the per-replan latency.
   std::vector<double> mission_replan_s;
+  // The same repairs in the repairing thread's own CPU time: the work, without the time the
+  // thread waited for a core (on a loaded machine the two differ by the scheduler's slices).
+  std::vector<double> mission_replan_cpu_s;
   // Customizing the shared hierarchy's metrics to the batch, once for all missions (0 on the turn
   // graph); paid under the overlay's exclusive lock, before the repairs.
   double customization_s = 0;

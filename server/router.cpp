@@ -206,6 +206,7 @@ Router::Router(DispatchService& service, TokenAuth auth, RouterConfig config, Cl
         metrics_.observe("congestion_replan_seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
         metrics_.count("replans_total", static_cast<double>(res.missions_replanned));
         for (double s : res.mission_replan_s) metrics_.observe("congestion_mission_replan_seconds", s);
+        for (double s : res.mission_replan_cpu_s) metrics_.observe("congestion_mission_replan_cpu_seconds", s);
         if (service_.hierarchy() != nullptr) metrics_.observe("congestion_customization_seconds", res.customization_s);
         return json_response(200, {{"edges_changed", res.edges_changed},
                                    {"missions_replanned", res.missions_replanned},

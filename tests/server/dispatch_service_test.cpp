@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <atomic>
 #include <map>
+#include <numeric>
 #include <random>
 #include <set>
 #include <thread>
@@ -296,6 +297,13 @@ TEST(DispatchService, RepairThreadsDoNotChangeTheRepairedRoutes) {
     EXPECT_GT(r.slowest_replan_s, 0.0);
     ASSERT_EQ(r.mission_replan_s.size(), r.missions_replanned);
     EXPECT_EQ(*std::max_element(r.mission_replan_s.begin(), r.mission_replan_s.end()), r.slowest_replan_s);
+    // The same repairs in CPU time: one per repair, each spent, and none beyond its wall time (the
+    // wall window encloses the CPU clock's reads; the thread clock's 1 µs grain gets a margin).
+    ASSERT_EQ(r.mission_replan_cpu_s.size(), r.missions_replanned);
+    const double cpu_total = std::accumulate(r.mission_replan_cpu_s.begin(), r.mission_replan_cpu_s.end(), 0.0);
+    const double wall_total = std::accumulate(r.mission_replan_s.begin(), r.mission_replan_s.end(), 0.0);
+    EXPECT_GT(cpu_total, 0.0);
+    EXPECT_LE(cpu_total, wall_total + 1e-5 * static_cast<double>(r.missions_replanned));
     routes.emplace_back();
     for (MissionId id : ids) routes.back().push_back(service.mission(id).route.edges);
   }

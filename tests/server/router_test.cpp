@@ -185,6 +185,9 @@ TEST(Router, CongestionRepairsAreTimedPerMissionInTheMetrics) {
   EXPECT_NE(metrics.find("corridor_congestion_mission_replan_seconds_count{} " + std::to_string(replanned) + "\n"),
             std::string::npos)
       << metrics;
+  EXPECT_NE(metrics.find("corridor_congestion_mission_replan_cpu_seconds_count{} " + std::to_string(replanned) + "\n"),
+            std::string::npos)
+      << metrics;
   EXPECT_NE(metrics.find("corridor_replans_total " + std::to_string(replanned) + "\n"), std::string::npos) << metrics;
 }
 
