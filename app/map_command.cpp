@@ -26,6 +26,7 @@ nlohmann::json describe(const maps::RoadGraph& g) {
           {"turns", g.turns().arc_count()},
           {"restriction_copies", g.turns().copy_count()},
           {"limited_edges", g.edge_limits().size()},
+          {"main_component_nodes", g.main_component_nodes()},
           {"traffic_keeps", g.left_hand_traffic() ? "left" : "right"}};
 }
 
@@ -58,7 +59,9 @@ void run_import(const ImportOptions& o) {
   j["osm_restrictions_applied"] = report.osm_restrictions_applied;
   j["osm_restrictions_unresolved"] = report.osm_restrictions_unresolved;
   j["graph_nodes_before_scc"] = report.graph.input_nodes;
+  // Kept since other tools read it; every road is kept now, so it counts nodes on no drivable road.
   j["dropped_nodes_outside_largest_scc"] = report.graph.dropped_nodes;
+  j["dropped_nodes"] = report.graph.dropped_nodes;
   j["strongly_connected_components"] = report.graph.components;
   std::cout << j.dump(2) << '\n';
 }
@@ -72,6 +75,7 @@ void run_info(const MapOptions& o) {
   j["load_seconds"] = info.seconds;
   if (info.origin == maps::MapLoadInfo::Origin::imported) {
     j["dropped_nodes_outside_largest_scc"] = info.import.graph.dropped_nodes;
+    j["dropped_nodes"] = info.import.graph.dropped_nodes;
   }
   std::cout << j.dump(2) << '\n';
 }

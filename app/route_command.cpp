@@ -81,8 +81,8 @@ void run_route(const RouteOptions& o) {
       throw maps::SnapError(e.reason(), std::string(which) + ": " + e.what());
     }
   };
-  const maps::SnapResult s = snap_or_explain(from, "--from");
-  const maps::SnapResult t = snap_or_explain(to, "--to");
+  maps::SnapResult s = snap_or_explain(from, "--from");
+  maps::SnapResult t = snap_or_explain(to, "--to");
 
   planner::CostOverlay overlay(graph);
   overlay.set_signal_delay(graph, o.signal_delay_s);
@@ -96,17 +96,20 @@ void run_route(const RouteOptions& o) {
   planner::VehicleProfile profile = planner::profile_by_name_or_file(o.profile);
   if (o.vmax_kmh) profile.vmax_mps = *o.vmax_kmh / 3.6;
   const planner::TravelCost cost(graph, overlay, profile);
-  const auto starts = planner::points_from_snap(graph, s, planner::PointRole::start);
-  const auto goals = planner::points_from_snap(graph, t, planner::PointRole::goal);
   planner::Route route;
-  if (algo == planner::Algorithm::dstar_lite) {
-    planner::DStarLite dstar(cost, starts, goals);
-    dstar.replan();
-    route = dstar.route();
-  } else {
-    planner::OneToOneSearch search;
-    route = search.run(planner::SearchSpace(cost, starts, goals), algo == planner::Algorithm::astar);
-  }
+  planner::plan_nearest_or_main(snapper, graph, from, s, to, t, snap, [&](const maps::SnapResult& a, const maps::SnapResult& b) {
+    const auto starts = planner::points_from_snap(graph, a, planner::PointRole::start);
+    const auto goals = planner::points_from_snap(graph, b, planner::PointRole::goal);
+    if (algo == planner::Algorithm::dstar_lite) {
+      planner::DStarLite dstar(cost, starts, goals);
+      dstar.replan();
+      route = dstar.route();
+    } else {
+      planner::OneToOneSearch search;
+      route = search.run(planner::SearchSpace(cost, starts, goals), algo == planner::Algorithm::astar);
+    }
+    return route.found;
+  });
   if (!route.found) throw std::runtime_error("no route: the destination cannot be reached from the start");
   auto feature = planner::route_to_geojson(graph, route, planner::to_string(algo));
   feature["properties"]["snap_distance_m"] = {s.distance_m, t.distance_m};

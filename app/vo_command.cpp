@@ -47,9 +47,14 @@ std::vector<maps::Point2> pick_drive(const maps::RoadGraph& graph, const SynthOp
   const planner::TravelCost cost(graph, overlay, {50.0 / 3.6});
   planner::OneToOneSearch search;
   planner::Rng rng(planner::derive_seed(o.seed, "vo-synth-route"));
-  const auto edges = static_cast<std::uint32_t>(graph.edge_count());
-  for (int attempt = 0; attempt < 400; ++attempt) {
-    const EdgeId a(rng.below(edges)), b(rng.below(edges));
+  // On the main component, where every pair of roads is joined.
+  std::vector<EdgeId> main_edges;
+  for (EdgeId e : graph.edges()) {
+    if (graph.in_main_component(e)) main_edges.push_back(e);
+  }
+  const auto edges = static_cast<std::uint32_t>(main_edges.size());
+  for (int attempt = 0; attempt < 400 && edges > 0; ++attempt) {
+    const EdgeId a = main_edges[rng.below(edges)], b = main_edges[rng.below(edges)];
     const planner::Route route =
         search.run(planner::SearchSpace(cost, {{a, 0.0}}, {{b, graph.length_m(b)}}), true);
     if (!route.found || route.length_m < o.length_m + 30.0) continue;

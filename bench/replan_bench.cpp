@@ -177,7 +177,14 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
   std::vector<double> planner_bytes;
   double expanded = 0, rekeyed = 0, raised = 0, path_checks = 0, astar_settled = 0, dijkstra_settled = 0;
   planner::OneToOneSearch astar, dijkstra;
-  std::uniform_int_distribution<std::uint32_t> any_edge(0, static_cast<std::uint32_t>(graph.edge_count() - 1));
+  // Trips start and end on the main component, where every pair of roads is joined (the map keeps
+  // cut-off roads too, which no trip between random roads could reach).
+  std::vector<EdgeId> main_edges;
+  for (EdgeId e : graph.edges()) {
+    if (graph.in_main_component(e)) main_edges.push_back(e);
+  }
+  if (main_edges.empty()) throw std::invalid_argument("bench replan: the map's main component has no roads");
+  std::uniform_int_distribution<std::size_t> any_edge(0, main_edges.size() - 1);
   auto t_pre = Clock::now();
   std::optional<planner::CchTopology> topology;
   if (config.eager_hierarchy || config.lazy_hierarchy) {
@@ -200,8 +207,8 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
     UpdateGenerator updates(graph, config, rng);
     EdgePoint start, goal;
     for (int attempt = 0;; ++attempt) {
-      start = {EdgeId{any_edge(rng)}, 0.0};
-      goal = {EdgeId{any_edge(rng)}, 0.0};
+      start = {main_edges[any_edge(rng)], 0.0};
+      goal = {main_edges[any_edge(rng)], 0.0};
       start.offset_m = graph.length_m(start.edge) * 0.5;
       goal.offset_m = graph.length_m(goal.edge) * 0.5;
       if (maps::distance_m(graph.point_along(start.edge, start.offset_m), graph.point_along(goal.edge, goal.offset_m)) >=

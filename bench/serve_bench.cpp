@@ -225,17 +225,23 @@ json run_serve_bench(const maps::RoadGraph& graph, const ServeBenchConfig& c) {
   std::vector<std::vector<json>> tracks(static_cast<std::size_t>(c.vehicles));
   {
     Client setup(port);
-    std::uniform_int_distribution<std::uint32_t> any_node(0, static_cast<std::uint32_t>(graph.node_count() - 1));
+    // Missions and vehicles on the main component, where every pair of places is joined.
+    std::vector<NodeId> main_nodes;
+    for (NodeId u : graph.nodes()) {
+      if (graph.in_main_component(u)) main_nodes.push_back(u);
+    }
+    std::uniform_int_distribution<std::size_t> pick(0, main_nodes.size() - 1);
+    const auto any_node = [&](std::mt19937_64& r) { return main_nodes[pick(r)]; };
     for (int v = 0; v < c.vehicles; ++v) {
       auto& track = tracks[static_cast<std::size_t>(v)];
       if (v >= c.missions) {
-        track.push_back(ll(graph, graph.position(NodeId{any_node(rng)})));
+        track.push_back(ll(graph, graph.position(any_node(rng))));
         continue;
       }
       for (int attempt = 0; attempt < 20 && track.empty(); ++attempt) {
         const json body{{"vehicle_id", "v" + std::to_string(v)},
-                        {"origin", ll(graph, graph.position(NodeId{any_node(rng)}))},
-                        {"destination", ll(graph, graph.position(NodeId{any_node(rng)}))}};
+                        {"origin", ll(graph, graph.position(any_node(rng)))},
+                        {"destination", ll(graph, graph.position(any_node(rng)))}};
         const auto [status, text] = setup.post("/v1/missions", body.dump());
         if (status != 201) continue;
         const json m = json::parse(text);

@@ -10,6 +10,7 @@ namespace corridor::maps {
 
 struct SnapOptions {
   double max_distance_m = 200.0;  // farther than this from every road is an error
+  bool main_component_only = false;  // only roads of the graph's main component (RoadGraph)
 };
 
 struct SnapResult {

@@ -51,7 +51,7 @@ double polyline_length(const std::vector<Point2>& pts, std::uint32_t first, std:
 
 }  // namespace
 
-RoadGraph build_road_graph(const GraphBuildInput& in, GraphBuildReport* report) {
+RoadGraph build_road_graph(const GraphBuildInput& in, GraphBuildReport* report, const GraphBuildOptions& options) {
   constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
   const auto n_in = static_cast<std::uint32_t>(in.node_pos.size());
 
@@ -72,7 +72,10 @@ RoadGraph build_road_graph(const GraphBuildInput& in, GraphBuildReport* report) 
     }
   }
 
-  // Largest strongly connected component, on a temporary CSR.
+  // Components, on a temporary CSR: reported, not pruned. Every road is kept, including a one-way
+  // street that leaves the extract and a car park's roads that join no public road (a route may
+  // start or end there); a node with no drivable road at all is dropped. RoadGraph marks the
+  // largest component as the main one, which snapping can prefer (planner/snap_points.hpp).
   std::vector<std::uint32_t> first_out(n_in + 1, 0), heads(edges.size());
   for (const auto& e : edges) ++first_out[e.tail + 1];
   std::partial_sum(first_out.begin(), first_out.end(), first_out.begin());
@@ -83,13 +86,15 @@ RoadGraph build_road_graph(const GraphBuildInput& in, GraphBuildReport* report) 
   const Components comps = strongly_connected_components(first_out, heads);
 
   // Isolated nodes (no edges at all) are their own component; they count as dropped.
+  std::vector<std::uint8_t> has_edge(n_in, 0);
+  for (const auto& e : edges) has_edge[e.tail] = has_edge[e.head] = 1;
   std::vector<std::uint32_t> new_id(n_in, kNone);
   RoadGraphData d;
   d.origin = in.origin;
   d.strings = in.strings;
   std::vector<std::uint32_t> members;
   for (std::uint32_t u = 0; u < n_in; ++u) {
-    if (comps.component_of[u] == comps.largest) members.push_back(u);
+    if (options.main_component_only ? comps.component_of[u] == comps.largest : has_edge[u] != 0) members.push_back(u);
   }
   if (!members.empty()) {
     Point2 lo = in.node_pos[members.front()];
@@ -115,7 +120,7 @@ RoadGraph build_road_graph(const GraphBuildInput& in, GraphBuildReport* report) 
     d.node_signalized.push_back(in.node_signalized[u]);
   }
 
-  // Keep edges inside the component, ordered by new tail (stable, so twins stay deterministic).
+  // Every edge, ordered by new tail (stable, so twins stay deterministic).
   std::vector<std::uint32_t> order;
   for (std::uint32_t i = 0; i < edges.size(); ++i) {
     if (new_id[edges[i].tail] != kNone && new_id[edges[i].head] != kNone) order.push_back(i);
@@ -125,7 +130,7 @@ RoadGraph build_road_graph(const GraphBuildInput& in, GraphBuildReport* report) 
   std::vector<std::uint32_t> new_edge(edges.size(), kNone);
   for (std::uint32_t i = 0; i < order.size(); ++i) new_edge[order[i]] = i;
 
-  if (order.empty()) throw MapLoadError("the map contains no connected drivable road network");
+  if (order.empty()) throw MapLoadError("the map contains no drivable road");
 
   d.first_out.assign(kept + 1, 0);
   d.geometry_first.push_back(0);
@@ -162,7 +167,10 @@ RoadGraph build_road_graph(const GraphBuildInput& in, GraphBuildReport* report) 
     report->kept_nodes = kept;
     report->dropped_nodes = n_in - kept;
     report->kept_edges = order.size();
-    report->components = comps.count;
+    report->components = options.main_component_only ? 1
+                                                     : comps.count - static_cast<std::size_t>(std::count(
+                                                                         has_edge.begin(), has_edge.end(), std::uint8_t{0}));
+    report->largest_component_nodes = comps.largest_size;
     report->signalized_nodes =
         static_cast<std::size_t>(std::count(d.node_signalized.begin(), d.node_signalized.end(), std::uint8_t{1}));
   }

@@ -1,5 +1,5 @@
-// Turns road segments between intersections into the CSR RoadGraph: directed edges, twins,
-// geometry, and only the largest strongly connected component.
+// Turns road segments between intersections into the CSR RoadGraph: directed edges, twins and
+// geometry, every strongly connected component kept (the largest is the graph's main component).
 #pragma once
 
 #include <cstdint>
@@ -42,13 +42,21 @@ struct GraphBuildInput {
 struct GraphBuildReport {
   std::size_t input_nodes = 0;
   std::size_t kept_nodes = 0;
-  std::size_t dropped_nodes = 0;  // outside the largest strongly connected component
+  std::size_t dropped_nodes = 0;  // on no drivable road
   std::size_t kept_edges = 0;
-  std::size_t components = 0;
+  std::size_t components = 0;  // strongly connected components of the kept nodes
+  std::size_t largest_component_nodes = 0;  // the main component
   std::size_t signalized_nodes = 0;
 };
 
+struct GraphBuildOptions {
+  // Keep only the main component (a generated network for experiments, where every pair of nodes
+  // must be joined); an imported map keeps every road.
+  bool main_component_only = false;
+};
+
 // Throws MapLoadError when no drivable road remains.
-RoadGraph build_road_graph(const GraphBuildInput& input, GraphBuildReport* report = nullptr);
+RoadGraph build_road_graph(const GraphBuildInput& input, GraphBuildReport* report = nullptr,
+                           const GraphBuildOptions& options = {});
 
 }  // namespace corridor::maps

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "maps/errors.hpp"
+#include "maps/strongly_connected.hpp"
 
 namespace corridor::maps {
 namespace {
@@ -108,6 +109,17 @@ RoadGraph::RoadGraph(RoadGraphData data) : data_(std::move(data)), projection_(d
   validate(data_);
   if (data_.landmarks.nodes.empty()) data_.landmarks = compute_landmarks(data_);
   turns_ = TurnGraph(data_);
+  {
+    // Derived, not stored: Tarjan takes a few milliseconds on a metro area, and a cache from before
+    // the importer kept every component stays correct.
+    std::vector<std::uint32_t> heads(edge_count());
+    for (EdgeId e : edges()) heads[e.index()] = head(e).v;
+    const Components c = strongly_connected_components(data_.first_out, heads);
+    main_component_.assign(node_count(), 0);
+    for (NodeId u : nodes()) main_component_[u.index()] = c.component_of[u.index()] == c.largest ? 1 : 0;
+    main_component_nodes_ = node_count() > 0 ? c.largest_size : 0;
+    runner_up_component_nodes_ = node_count() > 0 ? c.runner_up_size : 0;
+  }
 
   if (node_count() > 0) {
     min_corner_ = max_corner_ = position(NodeId{0});

@@ -150,6 +150,16 @@ class RoadGraph {
     return std::binary_search(data_.roundabout_edges.begin(), data_.roundabout_edges.end(), e);
   }
 
+  // The map's main component: its largest strongly connected part, where every node reaches every
+  // other. The importer keeps the rest as well (a one-way street that leaves the extract, a car
+  // park's service roads that join no public road): a route may start or end there, and a snap
+  // may prefer the main component when the nearest road is cut off (planner/snap_points.hpp).
+  [[nodiscard]] bool in_main_component(NodeId u) const { return main_component_[u.index()] != 0; }
+  [[nodiscard]] bool in_main_component(EdgeId e) const { return in_main_component(tail(e)) && in_main_component(head(e)); }
+  [[nodiscard]] std::size_t main_component_nodes() const { return main_component_nodes_; }
+  // The nodes of the next largest component: equal to the main one's when the largest is a tie.
+  [[nodiscard]] std::size_t runner_up_component_nodes() const { return runner_up_component_nodes_; }
+
   // The edge-based graph searches run on: turns, their angles and the restrictions on them.
   [[nodiscard]] const TurnGraph& turns() const { return turns_; }
   [[nodiscard]] bool left_hand_traffic() const {
@@ -164,6 +174,9 @@ class RoadGraph {
   RoadGraphData data_;
   LocalProjection projection_;
   TurnGraph turns_;
+  std::vector<std::uint8_t> main_component_;  // per node: 1 in the largest strongly connected part
+  std::size_t main_component_nodes_ = 0;
+  std::size_t runner_up_component_nodes_ = 0;
   Point2 min_corner_;
   Point2 max_corner_;
 };

@@ -59,6 +59,10 @@ Components strongly_connected_components(std::span<const std::uint32_t> first_ou
   }
   if (!sizes.empty()) {
     out.largest = static_cast<std::uint32_t>(std::max_element(sizes.begin(), sizes.end()) - sizes.begin());
+    out.largest_size = sizes[out.largest];
+    for (std::uint32_t c = 0; c < sizes.size(); ++c) {
+      if (c != out.largest) out.runner_up_size = std::max(out.runner_up_size, sizes[c]);
+    }
   }
   return out;
 }

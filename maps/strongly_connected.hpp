@@ -10,7 +10,9 @@ namespace corridor::maps {
 struct Components {
   std::vector<std::uint32_t> component_of;  // per node
   std::uint32_t count = 0;
-  std::uint32_t largest = 0;  // id of the component with the most nodes
+  std::uint32_t largest = 0;  // id of the component with the most nodes (the first of equals)
+  std::uint32_t largest_size = 0;  // its nodes
+  std::uint32_t runner_up_size = 0;  // the nodes of the next largest (0 with a single component)
 };
 
 // head[first_out[u] .. first_out[u+1]) are the successors of u.

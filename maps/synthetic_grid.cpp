@@ -53,7 +53,7 @@ RoadGraph make_perturbed_grid(const GridSpec& spec) {
       if (c + 1 < spec.cols && r + 1 < spec.rows && unit(rng) < spec.diagonal_fraction) add(u, u + spec.cols + 1);
     }
   }
-  return build_road_graph(in);
+  return build_road_graph(in, nullptr, GraphBuildOptions{.main_component_only = true});
 }
 
 }  // namespace corridor::maps

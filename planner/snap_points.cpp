@@ -1,5 +1,7 @@
 #include "planner/snap_points.hpp"
 
+#include "maps/errors.hpp"
+
 namespace corridor::planner {
 
 NodeId node_at_snap(const maps::RoadGraph& graph, const maps::SnapResult& snap) {
@@ -24,6 +26,21 @@ std::vector<EdgePoint> points_from_snap(const maps::RoadGraph& graph, const maps
   std::vector<EdgePoint> both{{snap.edge, snap.offset_m}};
   if (snap.twin.valid()) both.push_back({snap.twin, snap.twin_offset_m});
   return both;
+}
+
+std::optional<maps::SnapResult> main_component_snap(const maps::EdgeSnapper& snapper, const maps::RoadGraph& graph,
+                                                    maps::LatLon p, const maps::SnapResult& nearest,
+                                                    maps::SnapOptions options) {
+  const std::size_t main = graph.main_component_nodes();
+  if (graph.in_main_component(nearest.edge) || (main < kSmallComponentNodes && main <= graph.runner_up_component_nodes())) {
+    return std::nullopt;
+  }
+  options.main_component_only = true;
+  try {
+    return snapper.snap(p, options);
+  } catch (const maps::SnapError&) {
+    return std::nullopt;  // no road of the main component within reach
+  }
 }
 
 }  // namespace corridor::planner

@@ -2,6 +2,7 @@
 // for a coordinate at an intersection, every edge that leaves (start) or arrives at (goal) it.
 #pragma once
 
+#include <optional>
 #include <vector>
 
 #include "maps/edge_snapper.hpp"
@@ -25,5 +26,36 @@ std::vector<EdgePoint> points_from_snap(const maps::RoadGraph& graph, const maps
 
 // The node a snapped coordinate lies on (within kAtNodeM of an end of its edge), or invalid.
 NodeId node_at_snap(const maps::RoadGraph& graph, const maps::SnapResult& snap);
+
+// A component of fewer nodes is small (OSRM's default, `--small-component-size`). A small largest
+// component is taken for the main one only when no other is as large: on a clip of a few streets
+// cut at its border, the network they mostly form; on two separate test streets of equal size,
+// neither, and the nearest road wins.
+inline constexpr std::size_t kSmallComponentNodes = 1000;
+
+// The snap to plan from or to instead when no route joins the nearest roads: the nearest road of
+// the graph's main component, when `nearest` lies off it, that component is not small, and one of
+// its roads is within reach of p. So a click beside a car park that joins no public road reaches
+// the street beside it rather than failing, while a route onto a one-way street that leaves the
+// extract, which exists, is planned as clicked. nullopt: no such snap, keep the nearest.
+std::optional<maps::SnapResult> main_component_snap(const maps::EdgeSnapper& snapper, const maps::RoadGraph& graph,
+                                                    maps::LatLon p, const maps::SnapResult& nearest,
+                                                    maps::SnapOptions options);
+
+// Plans between the nearest roads, `plan(from, to)` returning whether it found a route; when it
+// found none, once more between main_component_snap's roads, if either end has one. `from` and
+// `to` are left at the snaps of the last plan.
+template <class Plan>
+bool plan_nearest_or_main(const maps::EdgeSnapper& snapper, const maps::RoadGraph& graph, maps::LatLon from_p,
+                          maps::SnapResult& from, maps::LatLon to_p, maps::SnapResult& to, const maps::SnapOptions& options,
+                          Plan&& plan) {
+  if (plan(from, to)) return true;
+  const auto from_main = main_component_snap(snapper, graph, from_p, from, options);
+  const auto to_main = main_component_snap(snapper, graph, to_p, to, options);
+  if (!from_main && !to_main) return false;
+  from = from_main.value_or(from);
+  to = to_main.value_or(to);
+  return plan(from, to);
+}
 
 }  // namespace corridor::planner

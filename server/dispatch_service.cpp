@@ -312,6 +312,20 @@ void DispatchService::publish_route(Mission& m, const std::string& reason, doubl
   announce_route(m, reason, now_s, staged);
 }
 
+bool DispatchService::plan_mission(Mission& m, maps::LatLon start, maps::SnapResult& from, maps::SnapResult& to,
+                                   std::optional<double> heading) {
+  return planner::plan_nearest_or_main(snapper_, graph_, start, from, m.row.destination, to, {config_.snap_max_distance_m},
+                                       [&](const maps::SnapResult& a, const maps::SnapResult& b) {
+                                         m.destination_local = b.point;
+                                         m.planner = make_planner(m.row, endpoints(a, Role::start, heading),
+                                                                  endpoints(b, Role::goal, std::nullopt));
+                                         m.model = m.planner.model();
+                                         m.planner.replan();
+                                         m.route = m.planner.route();
+                                         return m.route.found;
+                                       });
+}
+
 MissionView DispatchService::create_mission(const MissionRequest& req, double now_s) {
   if (req.vehicle_id.empty() || req.vehicle_id.size() > 64) throw bad_request("vehicle_id must be 1 to 64 characters");
   if (!(req.vmax_kmh >= 5.0 && req.vmax_kmh <= 250.0)) throw bad_request("vmax_kmh must be between 5 and 250");
@@ -353,15 +367,11 @@ MissionView DispatchService::create_mission(const MissionRequest& req, double no
   m->row = {next_mission_id_, req.vehicle_id, req.priority, req.vmax_kmh, req.destination, origin, MissionState::active, now_s, now_s,
             req.profile};
   m->last_position = origin;
-  m->destination_local = to.point;
   Staged staged;
   {
     // Planned and registered under one view of the costs, so no congestion change falls between.
     std::shared_lock costs(overlay_mutex_);
-    m->planner = make_planner(m->row, endpoints(from, Role::start, origin_heading), endpoints(to, Role::goal, std::nullopt));
-    m->model = m->planner.model();
-    m->planner.replan();
-    m->route = m->planner.route();
+    plan_mission(*m, *origin, from, to, origin_heading);
     m->route_time_s = now_s;
     if (!m->route.found) throw unprocessable("unreachable", "the destination cannot be reached from the origin");
     stage(staged, [row = m->row](Store& store) { store.insert_mission(row); });
@@ -624,17 +634,12 @@ void DispatchService::restore(double now_s) {
     }
     const maps::LatLon start = last ? last->position : row.origin.value_or(row.destination);
     try {
-      const auto from = snapper_.snap(start, {config_.snap_max_distance_m});
-      const auto to = snapper_.snap(row.destination, {config_.snap_max_distance_m});
+      auto from = snapper_.snap(start, {config_.snap_max_distance_m});
+      auto to = snapper_.snap(row.destination, {config_.snap_max_distance_m});
       auto m = std::make_shared<Mission>();
       m->row = row;
       m->last_position = start;
-      m->destination_local = to.point;
-      m->planner = make_planner(row, endpoints(from, Role::start, last ? last->heading_deg : std::nullopt),
-                                endpoints(to, Role::goal, std::nullopt));
-      m->model = m->planner.model();
-      m->planner.replan();
-      m->route = m->planner.route();
+      plan_mission(*m, start, from, to, last ? last->heading_deg : std::nullopt);
       m->route_time_s = now_s;
       m->history = restored_history(row.id);
       m->revision = m->history.empty() ? 0 : m->history.back().view.revision;

@@ -152,6 +152,12 @@ class DispatchService {
   // A planned mission's planner on the service's graph; call under the overlay's shared lock.
   MissionPlanner make_planner(const MissionRow& row, std::vector<planner::EdgePoint> starts,
                               std::vector<planner::EdgePoint> goals);
+  // Plans m (its row set) from `start` to its destination, snapped to `from` and `to`, with a second
+  // try from the main component's roads when an end lies on a road cut off from the rest
+  // (planner::plan_nearest_or_main); `from` and `to` end at the snaps planned from. Call under the
+  // overlay's shared lock. Whether a route was found.
+  bool plan_mission(Mission& m, maps::LatLon start, maps::SnapResult& from, maps::SnapResult& to,
+                    std::optional<double> heading);
   // Ends a mission in memory; the caller stores the new state (stage_state) first.
   void finish(Mission& m, MissionState state, double now_s, Staged& staged);
   void stage_state(const Mission& m, MissionState state, double now_s, Staged& staged) const;

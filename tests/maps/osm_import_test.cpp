@@ -118,20 +118,32 @@ TEST(OsmImport, AccessNoAndFootwaysAreExcluded) {
   EXPECT_FALSE(edge_between(g, 1, 5).valid());
 }
 
-TEST(OsmImport, KeepsLargestStronglyConnectedComponentAndReportsDropped) {
-  // A one-way spur 3 -> 7 is a trap: it leaves and never returns, so node 7 is dropped.
+TEST(OsmImport, KeepsEveryComponentAndMarksTheLargestAsMain) {
+  // A one-way spur 3 -> 7 leaves and never returns, and 8-9 joins nothing: both are kept, since a
+  // route may end on the spur and a click may land on either. Only 1, 3 and 4 form the main
+  // component. Node 2 lies inside way 60 and is no graph node; node 10 is on no way.
   OsmImportReport report;
   const auto g = import_fixture({at(1, 0, 0), at(2, 100, 0), at(3, 200, 0), at(4, 0, 100), at(7, 300, 0), at(8, 5000, 5000),
-                                 at(9, 5100, 5000)},
+                                 at(9, 5100, 5000), at(10, 200, 200)},
                                 {{60, {1, 2, 3}, kResidential},
                                  {63, {1, 4}, kResidential},
                                  {61, {3, 7}, {{"highway", "residential"}, {"oneway", "yes"}}},
                                  {62, {8, 9}, kResidential}},
                                 &report);
-  EXPECT_EQ(g.node_count(), 3u);  // 1, 3 and 4
-  EXPECT_FALSE(node_by_osm(g, 7).valid());
-  EXPECT_EQ(report.graph.dropped_nodes, 3u);  // 7, 8, 9
+  EXPECT_EQ(g.node_count(), 6u);  // 1, 3, 4, 7, 8 and 9
+  EXPECT_EQ(report.graph.dropped_nodes, 0u);
   EXPECT_EQ(report.graph.input_nodes, 6u);
+  EXPECT_EQ(report.graph.components, 3u);  // {1, 3, 4}, {7}, {8, 9}
+  EXPECT_EQ(report.graph.largest_component_nodes, 3u);
+  EXPECT_EQ(g.main_component_nodes(), 3u);
+  EXPECT_EQ(g.runner_up_component_nodes(), 2u);
+  for (long long osm : {1, 3, 4}) EXPECT_TRUE(g.in_main_component(node_by_osm(g, osm))) << osm;
+  for (long long osm : {7, 8, 9}) EXPECT_FALSE(g.in_main_component(node_by_osm(g, osm))) << osm;
+  ASSERT_TRUE(edge_between(g, 3, 7).valid());
+  EXPECT_FALSE(edge_between(g, 7, 3).valid());
+  EXPECT_FALSE(g.in_main_component(edge_between(g, 3, 7)));
+  EXPECT_TRUE(g.in_main_component(edge_between(g, 1, 3)));
+  EXPECT_FALSE(g.in_main_component(edge_between(g, 8, 9)));
 }
 
 TEST(OsmImport, SignalsAtAndNearJunctionsMarkTheJunction) {

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "maps/osm_import.hpp"
 #include "planner/route_geojson.hpp"
 #include "planner/snap_points.hpp"
 #include "planner/one_to_one_search.hpp"
@@ -11,6 +12,7 @@
 #include <algorithm>
 #include <queue>
 #include <random>
+#include "tests/maps/osm_fixture.hpp"
 #include "tests/planner/test_graphs_line.hpp"
 
 namespace corridor::planner {
@@ -171,6 +173,105 @@ TEST(SnapPoints, RoutesBetweenJunctionsCostTheNodeToNodeShortestPath) {
       EXPECT_EQ(g.head(r.edges.back()), to);
     }
   }
+}
+
+// Roads cut off from the main component (maps keeps them): a route onto a one-way spur that
+// leaves the network is planned as clicked; a start where no road leads on, or on an island,
+// gets its second try from the main component's nearest road; and where no component stands out
+// (two separate streets of equal size) the nearest road wins and there is no route between them.
+class CutOffRoads : public ::testing::Test {
+ protected:
+  static maps::RoadGraph import(const std::vector<maps::testing::FixtureNode>& nodes,
+                                const std::vector<maps::testing::FixtureWay>& ways) {
+    maps::testing::TempDir dir;
+    maps::testing::write_osm(dir.path() / "cut_off.osm", nodes, ways);
+    maps::OsmImportOptions options;
+    options.show_progress = false;
+    return maps::import_osm(dir.path() / "cut_off.osm", options);
+  }
+  // Plans with OneToOneSearch between the two clicks (x, y in metres), as `corridor route` does.
+  static bool plan(const maps::RoadGraph& g, const maps::EdgeSnapper& snapper, maps::Point2 a, maps::Point2 b,
+                   maps::SnapResult& from, maps::SnapResult& to) {
+    const CostOverlay overlay(g);
+    const TravelCost cost(g, overlay, VehicleProfile{});
+    const maps::LatLon pa = g.projection().to_lat_lon(a), pb = g.projection().to_lat_lon(b);
+    from = snapper.snap(pa);
+    to = snapper.snap(pb);
+    return plan_nearest_or_main(snapper, g, pa, from, pb, to, {}, [&](const maps::SnapResult& s, const maps::SnapResult& t) {
+      OneToOneSearch search;
+      return search
+          .run(SearchSpace(cost, points_from_snap(g, s, PointRole::start), points_from_snap(g, t, PointRole::goal)), false)
+          .found;
+    });
+  }
+  static maps::Point2 at(const maps::RoadGraph& g, double x_m, double y_m) {
+    const auto p = maps::testing::at(0, x_m, y_m);
+    return g.projection().to_local({p.lat, p.lon});
+  }
+};
+
+TEST_F(CutOffRoads, OnlyWhatNoRouteJoinsMovesToTheMainComponent) {
+  using maps::testing::FixtureNode;
+  const std::map<std::string, std::string> road{{"highway", "residential"}};
+  const std::map<std::string, std::string> one_way{{"highway", "residential"}, {"oneway", "yes"}};
+  // The main component: a two-way 3 x 3 grid, 100 m apart (nodes 1-9, 1 at the origin). A one-way
+  // spur from node 3 (200, 0) east to 20, where no road leads on; an island 30-31 along y = -60.
+  std::vector<FixtureNode> nodes;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) nodes.push_back(maps::testing::at(1 + r * 3 + c, c * 100.0, r * 100.0));
+  }
+  nodes.push_back(maps::testing::at(20, 300, 0));
+  nodes.push_back(maps::testing::at(30, 0, -60));
+  nodes.push_back(maps::testing::at(31, 200, -60));
+  std::vector<maps::testing::FixtureWay> ways;
+  for (int r = 0; r < 3; ++r) ways.push_back({100 + r, {1 + r * 3LL, 2 + r * 3LL, 3 + r * 3LL}, road});
+  for (int c = 0; c < 3; ++c) ways.push_back({200 + c, {1LL + c, 4LL + c, 7LL + c}, road});
+  ways.push_back({300, {3, 20}, one_way});
+  ways.push_back({400, {30, 31}, road});
+  const maps::RoadGraph g = import(nodes, ways);
+  ASSERT_EQ(g.main_component_nodes(), 9u);
+  const maps::EdgeSnapper snapper(g);
+  maps::SnapResult from, to;
+
+  // Onto the spur's end: a route exists, so the goal stays on the spur.
+  ASSERT_TRUE(plan(g, snapper, at(g, 100, 200), at(g, 300, 0), from, to));
+  EXPECT_FALSE(g.in_main_component(to.edge));
+  EXPECT_NEAR(to.distance_m, 0.0, 0.5);
+  // From it: nothing leads on, so the start moves to the main component's nearest road (node 3).
+  ASSERT_TRUE(plan(g, snapper, at(g, 300, 0), at(g, 0, 200), from, to));
+  EXPECT_TRUE(g.in_main_component(from.edge));
+  EXPECT_NEAR(from.distance_m, 100.0, 0.5);
+  // From the island, 10 m off it and 50 m off the grid's bottom row: the row.
+  ASSERT_TRUE(plan(g, snapper, at(g, 100, -50), at(g, 0, 200), from, to));
+  EXPECT_TRUE(g.in_main_component(from.edge));
+  EXPECT_NEAR(from.distance_m, 50.0, 0.5);
+  // Along the island itself: planned there.
+  ASSERT_TRUE(plan(g, snapper, at(g, 20, -55), at(g, 180, -55), from, to));
+  EXPECT_FALSE(g.in_main_component(from.edge));
+  EXPECT_FALSE(g.in_main_component(to.edge));
+  // No road of the main component within reach: no second snap.
+  const maps::LatLon click = g.projection().to_lat_lon(at(g, 100, -50));
+  const maps::SnapResult island = snapper.snap(click);
+  EXPECT_FALSE(main_component_snap(snapper, g, click, island, {.max_distance_m = 40.0}).has_value());
+  ASSERT_TRUE(main_component_snap(snapper, g, click, island, {}).has_value());
+  // Main-only snapping passes the nearer island road by.
+  EXPECT_FALSE(g.in_main_component(snapper.snap(click).edge));
+  EXPECT_TRUE(g.in_main_component(snapper.snap(click, {.main_component_only = true}).edge));
+}
+
+TEST_F(CutOffRoads, TwoSeparateStreetsOfEqualSizeHaveNoMainComponentToFallBackOn) {
+  const std::map<std::string, std::string> road{{"highway", "residential"}};
+  // OSRM's "2 unconnected parallel ways": a-b-c and, 100 m south, d-e-f.
+  const maps::RoadGraph g = import({maps::testing::at(1, 0, 0), maps::testing::at(2, 100, 0), maps::testing::at(3, 200, 0),
+                                    maps::testing::at(4, 0, -100), maps::testing::at(5, 100, -100), maps::testing::at(6, 200, -100)},
+                                   {{10, {1, 2, 3}, road}, {11, {4, 5, 6}, road}});
+  ASSERT_EQ(g.main_component_nodes(), g.runner_up_component_nodes());
+  const maps::EdgeSnapper snapper(g);
+  maps::SnapResult from, to;
+  EXPECT_TRUE(plan(g, snapper, at(g, 0, -100), at(g, 100, -100), from, to));
+  EXPECT_TRUE(plan(g, snapper, at(g, 0, 0), at(g, 200, 0), from, to));
+  EXPECT_FALSE(plan(g, snapper, at(g, 0, 0), at(g, 0, -100), from, to));
+  EXPECT_FALSE(plan(g, snapper, at(g, 200, -100), at(g, 100, 0), from, to));
 }
 
 }  // namespace
