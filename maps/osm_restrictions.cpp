@@ -56,7 +56,9 @@ bool read_restriction(const osmium::Relation& rel, std::vector<OsmRestriction>& 
     const std::string_view value = tag(t, key);
     const bool no = value.starts_with("no_");
     const bool only = value.starts_with("only_");
-    if (!no && !only) continue;
+    // no_right_turn_on_red and the like forbid a turn against a red light only, which the signal
+    // itself governs (and which a preempting vehicle does not meet): no ban on the turn.
+    if ((!no && !only) || value.ends_with("_on_red")) continue;
     OsmRestriction r = base;
     r.only = only;
     r.u_turn = value.ends_with("u_turn");

@@ -149,6 +149,13 @@ TEST(TurnRules, ExceptNamingEmergencyOrPsvLiftsTheRestriction) {
   EXPECT_NE(south_to_west(g).ways, kLeftAtTwo);
 }
 
+TEST(TurnRules, TurnsBannedOnRedOnlyStayOpen) {
+  for (const char* value : {"no_left_turn_on_red", "no_turn_on_red"}) {
+    const auto g = plus_map({restriction({{'w', kSouth, "from"}, {'n', 2, "via"}, {'w', kWest, "to"}}, {{"restriction", value}})});
+    EXPECT_EQ(south_to_west(g).ways, kLeftAtTwo) << value;
+  }
+}
+
 TEST(TurnRules, ModeSpecificRestrictionsBindTheirModesOnly) {
   auto with_key = [](const char* key) {
     return plus_map({restriction({{'w', kSouth, "from"}, {'n', 2, "via"}, {'w', kWest, "to"}}, {{key, "no_left_turn"}})});
