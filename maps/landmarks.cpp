@@ -71,9 +71,12 @@ std::uint32_t free_flow_ticks(double length_m, double speed_mps) {
   return ticks >= static_cast<double>(kLandmarkUnreachable) ? kLandmarkUnreachable - 1 : static_cast<std::uint32_t>(ticks);
 }
 
-LandmarkTables compute_landmarks(const RoadGraphData& d, std::size_t count) {
+LandmarkTables compute_landmarks(const RoadGraphData& d, std::size_t count, std::span<const std::uint8_t> candidate) {
   const std::size_t n = d.node_x_m.size();
-  const std::size_t k = std::min(count, n);
+  const auto eligible = [&](std::size_t v) { return candidate.empty() || candidate[v] != 0; };
+  std::size_t eligible_nodes = 0;
+  for (std::size_t v = 0; v < n; ++v) eligible_nodes += eligible(v) ? 1 : 0;
+  const std::size_t k = std::min(count, eligible_nodes);
   LandmarkTables t;
   if (k == 0) return t;
   std::vector<std::uint32_t> weight(d.edge_head.size());
@@ -88,19 +91,22 @@ LandmarkTables compute_landmarks(const RoadGraphData& d, std::size_t count) {
       nearest[v] = std::min(nearest[v], trip);
     }
   };
+  std::size_t first_eligible = 0;
+  while (!eligible(first_eligible)) ++first_eligible;
   auto farthest = [&] {
-    // Unreachable nodes (kInf) win, so another component gets a landmark of its own.
-    std::size_t best = 0;
-    for (std::size_t v = 1; v < n; ++v) {
-      if (nearest[v] > nearest[best]) best = v;
+    // Among the candidates, unreachable nodes (kInf) win, so another component gets a landmark of
+    // its own.
+    std::size_t best = first_eligible;
+    for (std::size_t v = first_eligible + 1; v < n; ++v) {
+      if (eligible(v) && nearest[v] > nearest[best]) best = v;
     }
     return NodeId{static_cast<std::uint32_t>(best)};
   };
 
-  // Seed from node 0: the first landmark is the node farthest from it, not node 0 itself.
+  // Seed from the first candidate: the first landmark is the node farthest from it, not the seed.
   {
-    const std::vector<Ticks> there = dijkstra.run(NodeId{0}, true);
-    const std::vector<Ticks> back = dijkstra.run(NodeId{0}, false);
+    const std::vector<Ticks> there = dijkstra.run(NodeId{static_cast<std::uint32_t>(first_eligible)}, true);
+    const std::vector<Ticks> back = dijkstra.run(NodeId{static_cast<std::uint32_t>(first_eligible)}, false);
     add_round_trips(there, back);
   }
   t.nodes.reserve(k);

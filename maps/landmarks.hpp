@@ -41,8 +41,12 @@ std::uint32_t free_flow_ticks(double length_m, double speed_mps);
 
 // Chooses up to `count` landmarks by farthest selection (each new landmark is the node whose
 // round-trip time to the nearest chosen one is largest, so they spread to the map's rim, where they
-// bound best) and fills both tables. Needs the forward and reverse CSR of `data`.
-LandmarkTables compute_landmarks(const RoadGraphData& data, std::size_t count = kDefaultLandmarkCount);
+// bound best) and fills both tables. Needs the forward and reverse CSR of `data`. Only nodes with
+// `candidate[v] != 0` are chosen (all when empty): RoadGraph passes its main component, since a
+// node no landmark reaches would otherwise win every round, and a map with many cut-off roads would
+// spend all its landmarks on them, where they bound nothing.
+LandmarkTables compute_landmarks(const RoadGraphData& data, std::size_t count = kDefaultLandmarkCount,
+                                 std::span<const std::uint8_t> candidate = {});
 
 // The landmark lower bound in ticks on the travel time from a to b, given their table rows:
 // max over landmarks of d(L,b) - d(L,a) and d(a,L) - d(b,L), and never below 0.

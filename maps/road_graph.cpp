@@ -107,11 +107,8 @@ RoadGraph::RoadGraph(RoadGraphData data) : data_(std::move(data)), projection_(d
   if (data_.edge_ref.empty()) data_.edge_ref.assign(data_.edge_head.size(), 0);
   if (data_.strings.first.empty()) data_.strings.first = {0, 0};
   validate(data_);
-  if (data_.landmarks.nodes.empty()) data_.landmarks = compute_landmarks(data_);
-  turns_ = TurnGraph(data_);
   {
-    // Derived, not stored: Tarjan takes a few milliseconds on a metro area, and a cache from before
-    // the importer kept every component stays correct.
+    // Derived, not stored: Tarjan takes a few milliseconds on a metro area.
     std::vector<std::uint32_t> heads(edge_count());
     for (EdgeId e : edges()) heads[e.index()] = head(e).v;
     const Components c = strongly_connected_components(data_.first_out, heads);
@@ -120,6 +117,9 @@ RoadGraph::RoadGraph(RoadGraphData data) : data_(std::move(data)), projection_(d
     main_component_nodes_ = node_count() > 0 ? c.largest_size : 0;
     runner_up_component_nodes_ = node_count() > 0 ? c.runner_up_size : 0;
   }
+  // Landmarks on the main component only (maps/landmarks.hpp says why).
+  if (data_.landmarks.nodes.empty()) data_.landmarks = compute_landmarks(data_, kDefaultLandmarkCount, main_component_);
+  turns_ = TurnGraph(data_);
 
   if (node_count() > 0) {
     min_corner_ = max_corner_ = position(NodeId{0});

@@ -42,9 +42,10 @@ std::optional<maps::SnapResult> main_component_snap(const maps::EdgeSnapper& sna
                                                     maps::LatLon p, const maps::SnapResult& nearest,
                                                     maps::SnapOptions options);
 
-// Plans between the nearest roads, `plan(from, to)` returning whether it found a route; when it
-// found none, once more between main_component_snap's roads, if either end has one. `from` and
-// `to` are left at the snaps of the last plan.
+// Plans between the nearest roads, `plan(from, to)` returning whether it found a route. When it
+// found none, an end with a main_component_snap moves there: one end at a time first (a start on
+// an island must not move a destination that is reachable as clicked), then both. `from` and `to`
+// are left at the snaps of the last plan.
 template <class Plan>
 bool plan_nearest_or_main(const maps::EdgeSnapper& snapper, const maps::RoadGraph& graph, maps::LatLon from_p,
                           maps::SnapResult& from, maps::LatLon to_p, maps::SnapResult& to, const maps::SnapOptions& options,
@@ -52,9 +53,18 @@ bool plan_nearest_or_main(const maps::EdgeSnapper& snapper, const maps::RoadGrap
   if (plan(from, to)) return true;
   const auto from_main = main_component_snap(snapper, graph, from_p, from, options);
   const auto to_main = main_component_snap(snapper, graph, to_p, to, options);
-  if (!from_main && !to_main) return false;
-  from = from_main.value_or(from);
-  to = to_main.value_or(to);
+  const maps::SnapResult from_nearest = from, to_nearest = to;
+  if (from_main && plan(*from_main, to_nearest)) {
+    from = *from_main;
+    return true;
+  }
+  if (to_main && plan(from_nearest, *to_main)) {
+    to = *to_main;
+    return true;
+  }
+  if (!from_main || !to_main) return false;
+  from = *from_main;
+  to = *to_main;
   return plan(from, to);
 }
 

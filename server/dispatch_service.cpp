@@ -572,6 +572,14 @@ PositionResult DispatchService::report_position(const PositionReport& p, double 
   const std::vector<EdgeId> old_edges = m.route.edges;
   // This repair also covers any cost change the planner heard of since its last one.
   const std::string reason = repair(m, &points).value_or("off_route");
+  if (!m.route.found) {
+    // On a road cut off from the rest (a car park that joins no public road): on from the main
+    // component's nearest road, as when the mission was planned, rather than ending the mission.
+    if (const auto main = planner::main_component_snap(snapper_, graph_, p.position, snap, {config_.snap_max_distance_m})) {
+      auto from_main = endpoints(*main, Role::start, p.heading_deg);
+      repair(m, &from_main);
+    }
+  }
   result.eta_s = m.route.travel_time_s;
   m.route_time_s = now_s;
   emit(position_event(p, now_s, m.row.id, m.route.found ? std::optional<double>(m.route.travel_time_s) : std::nullopt));

@@ -11,7 +11,9 @@ SyntheticTrace make_synthetic_trace(const maps::RoadGraph& g, const SyntheticTra
   std::normal_distribution<double> noise(0.0, spec.noise_sigma_m);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::vector<EdgeId> walk;
+  // The walk starts on the main component, where it can go on at every junction but a dead end.
   EdgeId e{static_cast<std::uint32_t>(rng() % g.edge_count())};
+  for (int draw = 0; draw < 1000 && !g.in_main_component(e); ++draw) e = EdgeId{static_cast<std::uint32_t>(rng() % g.edge_count())};
   for (std::size_t k = 0; k < spec.edges; ++k) {
     walk.push_back(e);
     std::vector<EdgeId> next;

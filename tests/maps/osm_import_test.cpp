@@ -146,6 +146,36 @@ TEST(OsmImport, KeepsEveryComponentAndMarksTheLargestAsMain) {
   EXPECT_FALSE(g.in_main_component(edge_between(g, 8, 9)));
 }
 
+// Landmarks go to the main component, however many cut-off roads the map has: a node no landmark
+// reaches would otherwise win every round of the farthest selection, and 20 islands would take all
+// 16 landmarks, where they bound nothing.
+TEST(OsmImport, LandmarksLieOnTheMainComponentWhateverTheCutOffRoads) {
+  std::vector<FixtureNode> nodes;
+  std::vector<FixtureWay> ways;
+  // The main component: a 6 x 6 grid of two-way streets, 100 m apart (every node a junction).
+  for (int r = 0; r < 6; ++r) {
+    for (int c = 0; c < 6; ++c) nodes.push_back(at(1 + r * 6 + c, c * 100.0, r * 100.0));
+  }
+  for (int i = 0; i < 6; ++i) {
+    std::vector<long long> row, column;
+    for (int j = 0; j < 6; ++j) {
+      row.push_back(1 + i * 6LL + j);
+      column.push_back(1 + j * 6LL + i);
+    }
+    ways.push_back({10 + i, row, kResidential});
+    ways.push_back({20 + i, column, kResidential});
+  }
+  for (int i = 0; i < 20; ++i) {
+    nodes.push_back(at(1000 + 2 * i, i * 100.0, 5000));
+    nodes.push_back(at(1001 + 2 * i, i * 100.0 + 50, 5000));
+    ways.push_back({100 + i, {1000 + 2LL * i, 1001 + 2LL * i}, kResidential});
+  }
+  const auto g = import_fixture(nodes, ways);
+  ASSERT_EQ(g.main_component_nodes(), 36u);
+  ASSERT_EQ(g.landmark_count(), kDefaultLandmarkCount);
+  for (NodeId l : g.data().landmarks.nodes) EXPECT_TRUE(g.in_main_component(l)) << l.v;
+}
+
 TEST(OsmImport, SignalsAtAndNearJunctionsMarkTheJunction) {
   const std::map<std::string, std::string> signal{{"highway", "traffic_signals"}};
   // Junction 3 has a signal 20 m before it on way 70; junction 5 carries the tag itself; the signal

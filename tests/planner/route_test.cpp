@@ -245,6 +245,11 @@ TEST_F(CutOffRoads, OnlyWhatNoRouteJoinsMovesToTheMainComponent) {
   ASSERT_TRUE(plan(g, snapper, at(g, 100, -50), at(g, 0, 200), from, to));
   EXPECT_TRUE(g.in_main_component(from.edge));
   EXPECT_NEAR(from.distance_m, 50.0, 0.5);
+  // From the island onto the spur's end: only the start moves; the spur is reachable as clicked.
+  ASSERT_TRUE(plan(g, snapper, at(g, 100, -50), at(g, 300, 0), from, to));
+  EXPECT_TRUE(g.in_main_component(from.edge));
+  EXPECT_FALSE(g.in_main_component(to.edge));
+  EXPECT_NEAR(to.distance_m, 0.0, 0.5);
   // Along the island itself: planned there.
   ASSERT_TRUE(plan(g, snapper, at(g, 20, -55), at(g, 180, -55), from, to));
   EXPECT_FALSE(g.in_main_component(from.edge));

@@ -16,6 +16,8 @@
 #include "maps/synthetic_grid.hpp"
 #include "planner/one_to_one_search.hpp"
 #include "preemption/signal_costs.hpp"
+#include "maps/osm_import.hpp"
+#include "tests/maps/osm_fixture.hpp"
 #include "tests/server/temp_db.hpp"
 
 namespace corridor::server {
@@ -115,6 +117,51 @@ TEST(DispatchService, RejectsBadRequestsWithStatusCodes) {
   EXPECT_EQ(code_of([&] { service.report_congestion({u}, 0.0); }), 400);
 }
 
+// A 3 x 3 grid of two-way streets 100 m apart and, 60 m south of it, a street that joins nothing
+// (a car park's): an ambulance there is dispatched from the grid's nearest street, and its position
+// reports from the car park keep the mission going instead of ending it for want of a route.
+TEST(DispatchService, AVehicleOnARoadCutOffFromTheRestGoesOnFromTheNearestStreetThatLeadsOn) {
+  using maps::testing::at;
+  const std::map<std::string, std::string> road{{"highway", "residential"}};
+  std::vector<maps::testing::FixtureNode> nodes;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) nodes.push_back(at(1 + r * 3 + c, c * 100.0, r * 100.0));
+  }
+  nodes.push_back(at(30, 0, -60));
+  nodes.push_back(at(31, 200, -60));
+  std::vector<maps::testing::FixtureWay> ways;
+  for (int r = 0; r < 3; ++r) ways.push_back({100 + r, {1 + r * 3LL, 2 + r * 3LL, 3 + r * 3LL}, road});
+  for (int c = 0; c < 3; ++c) ways.push_back({200 + c, {1LL + c, 4LL + c, 7LL + c}, road});
+  ways.push_back({400, {30, 31}, road});
+  maps::testing::TempDir dir;
+  maps::testing::write_osm(dir.path() / "car_park.osm", nodes, ways);
+  maps::OsmImportOptions options;
+  options.show_progress = false;
+  const maps::RoadGraph g = maps::import_osm(dir.path() / "car_park.osm", options);
+  ASSERT_EQ(g.main_component_nodes(), 9u);
+  const auto ll = [](double x, double y) {
+    const auto n = at(0, x, y);
+    return maps::LatLon{n.lat, n.lon};
+  };
+  DispatchService service(g, {}, nullptr, 0.0);
+  MissionRequest r = request("amb-car-park");
+  r.origin = ll(100, -58);  // on the car park's street
+  r.destination = ll(200, 200);
+  const MissionView m = service.create_mission(r, 0.0);
+  ASSERT_TRUE(m.route.found);
+  EXPECT_TRUE(g.in_main_component(m.route.edges.front()));
+  PositionReport p;
+  p.vehicle_id = "amb-car-park";
+  p.position = ll(120, -60);
+  p.timestamp_s = 1.0;
+  const PositionResult res = service.report_position(p, 1.0);
+  EXPECT_FALSE(res.completed);
+  const MissionView after = service.mission(m.id);
+  EXPECT_EQ(after.state, MissionState::active);
+  ASSERT_TRUE(after.route.found);
+  EXPECT_TRUE(g.in_main_component(after.route.edges.front()));
+}
+
 // Drive the vehicle along its route with position reports: the start advances, signals behind it
 // are released, and the mission completes at the destination.
 TEST(DispatchService, PositionsAlongTheRouteCompleteTheMission) {
@@ -182,7 +229,7 @@ TEST(DispatchService, CongestionOnTheRouteChangesIt) {
 // Missions are served in parallel (one lock per mission), so several threads post positions,
 // congestion, counts and reads at once; afterwards every plan must still be the optimal route
 // under the final costs (the Dijkstra oracle), and every position must be stored. Run under TSan too.
-class ConcurrentReports : public testing::TestWithParam<PlannerGraph> {};
+class ConcurrentReports : public ::testing::TestWithParam<PlannerGraph> {};
 
 TEST_P(ConcurrentReports, KeepEveryPlanOptimal) {
   TempDb db;
@@ -270,8 +317,8 @@ TEST_P(ConcurrentReports, KeepEveryPlanOptimal) {
   EXPECT_GT(positions.load(), 300);
 }
 
-INSTANTIATE_TEST_SUITE_P(DispatchService, ConcurrentReports, testing::Values(PlannerGraph::turn_graph, PlannerGraph::hierarchy),
-                         [](const testing::TestParamInfo<PlannerGraph>& p) {
+INSTANTIATE_TEST_SUITE_P(DispatchService, ConcurrentReports, ::testing::Values(PlannerGraph::turn_graph, PlannerGraph::hierarchy),
+                         [](const ::testing::TestParamInfo<PlannerGraph>& p) {
                            return p.param == PlannerGraph::hierarchy ? std::string("hierarchy") : std::string("turn_graph");
                          });
 
