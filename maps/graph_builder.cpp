@@ -72,29 +72,29 @@ RoadGraph build_road_graph(const GraphBuildInput& in, GraphBuildReport* report, 
     }
   }
 
-  // Components, on a temporary CSR: reported, not pruned. Every road is kept, including a one-way
-  // street that leaves the extract and a car park's roads that join no public road (a route may
-  // start or end there); a node with no drivable road at all is dropped. RoadGraph marks the
-  // largest component as the main one, which snapping can prefer (planner/snap_points.hpp).
-  std::vector<std::uint32_t> first_out(n_in + 1, 0), heads(edges.size());
-  for (const auto& e : edges) ++first_out[e.tail + 1];
-  std::partial_sum(first_out.begin(), first_out.end(), first_out.begin());
-  {
+  // Every road is kept, including a one-way street that leaves the extract and a car park's roads
+  // that join no public road (a route may start or end there); a node with no drivable road at all
+  // is dropped. RoadGraph finds the components and marks the largest as the main one, which
+  // snapping can prefer (planner/snap_points.hpp). A generated network keeps only that one.
+  std::vector<std::uint8_t> keep(n_in, 0);
+  if (options.main_component_only) {
+    std::vector<std::uint32_t> first_out(n_in + 1, 0), heads(edges.size());
+    for (const auto& e : edges) ++first_out[e.tail + 1];
+    std::partial_sum(first_out.begin(), first_out.end(), first_out.begin());
     std::vector<std::uint32_t> fill(first_out.begin(), first_out.end() - 1);
     for (const auto& e : edges) heads[fill[e.tail]++] = e.head;
+    const Components comps = strongly_connected_components(first_out, heads);
+    for (std::uint32_t u = 0; u < n_in; ++u) keep[u] = comps.component_of[u] == comps.largest ? 1 : 0;
+  } else {
+    for (const auto& e : edges) keep[e.tail] = keep[e.head] = 1;
   }
-  const Components comps = strongly_connected_components(first_out, heads);
-
-  // Isolated nodes (no edges at all) are their own component; they count as dropped.
-  std::vector<std::uint8_t> has_edge(n_in, 0);
-  for (const auto& e : edges) has_edge[e.tail] = has_edge[e.head] = 1;
   std::vector<std::uint32_t> new_id(n_in, kNone);
   RoadGraphData d;
   d.origin = in.origin;
   d.strings = in.strings;
   std::vector<std::uint32_t> members;
   for (std::uint32_t u = 0; u < n_in; ++u) {
-    if (options.main_component_only ? comps.component_of[u] == comps.largest : has_edge[u] != 0) members.push_back(u);
+    if (keep[u] != 0) members.push_back(u);
   }
   if (!members.empty()) {
     Point2 lo = in.node_pos[members.front()];
@@ -162,19 +162,19 @@ RoadGraph build_road_graph(const GraphBuildInput& in, GraphBuildReport* report, 
   std::partial_sum(d.first_out.begin(), d.first_out.end(), d.first_out.begin());
   build_reverse_adjacency(d);
 
+  const std::size_t signalized =
+      static_cast<std::size_t>(std::count(d.node_signalized.begin(), d.node_signalized.end(), std::uint8_t{1}));
+  RoadGraph graph(std::move(d));
   if (report != nullptr) {
     report->input_nodes = n_in;
     report->kept_nodes = kept;
     report->dropped_nodes = n_in - kept;
     report->kept_edges = order.size();
-    report->components = options.main_component_only ? 1
-                                                     : comps.count - static_cast<std::size_t>(std::count(
-                                                                         has_edge.begin(), has_edge.end(), std::uint8_t{0}));
-    report->largest_component_nodes = comps.largest_size;
-    report->signalized_nodes =
-        static_cast<std::size_t>(std::count(d.node_signalized.begin(), d.node_signalized.end(), std::uint8_t{1}));
+    report->components = graph.component_count();
+    report->largest_component_nodes = graph.main_component_nodes();
+    report->signalized_nodes = signalized;
   }
-  return RoadGraph(std::move(d));
+  return graph;
 }
 
 }  // namespace corridor::maps

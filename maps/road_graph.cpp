@@ -116,6 +116,7 @@ RoadGraph::RoadGraph(RoadGraphData data) : data_(std::move(data)), projection_(d
     for (NodeId u : nodes()) main_component_[u.index()] = c.component_of[u.index()] == c.largest ? 1 : 0;
     main_component_nodes_ = node_count() > 0 ? c.largest_size : 0;
     runner_up_component_nodes_ = node_count() > 0 ? c.runner_up_size : 0;
+    component_count_ = c.count;
   }
   // Landmarks on the main component only (maps/landmarks.hpp says why).
   if (data_.landmarks.nodes.empty()) data_.landmarks = compute_landmarks(data_, kDefaultLandmarkCount, main_component_);

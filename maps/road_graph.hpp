@@ -159,6 +159,7 @@ class RoadGraph {
   [[nodiscard]] std::size_t main_component_nodes() const { return main_component_nodes_; }
   // The nodes of the next largest component: equal to the main one's when the largest is a tie.
   [[nodiscard]] std::size_t runner_up_component_nodes() const { return runner_up_component_nodes_; }
+  [[nodiscard]] std::size_t component_count() const { return component_count_; }
 
   // The edge-based graph searches run on: turns, their angles and the restrictions on them.
   [[nodiscard]] const TurnGraph& turns() const { return turns_; }
@@ -177,6 +178,7 @@ class RoadGraph {
   std::vector<std::uint8_t> main_component_;  // per node: 1 in the largest strongly connected part
   std::size_t main_component_nodes_ = 0;
   std::size_t runner_up_component_nodes_ = 0;
+  std::size_t component_count_ = 0;
   Point2 min_corner_;
   Point2 max_corner_;
 };

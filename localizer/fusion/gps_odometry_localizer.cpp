@@ -20,7 +20,11 @@ const char* to_string(PositionSource s) {
 
 GpsOdometryLocalizer::GpsOdometryLocalizer(const maps::RoadGraph& graph, const maps::EdgeSnapper& snapper,
                                            LocalizerConfig config)
-    : graph_(graph), config_(config), hmm_(graph, snapper, config.hmm), odometry_(graph, config.odometry, &snapper) {}
+    : graph_(graph),
+      config_(config),
+      hmm_(graph, snapper, config.hmm),
+      odometry_(graph, config.odometry, &snapper),
+      takeover_s_(config.gps_timeout_s) {}
 
 double GpsOdometryLocalizer::road_heading_deg(EdgeId e, double offset_m) const {
   return road_bearing_deg(graph_, e, offset_m, 3.0);
@@ -143,6 +147,7 @@ LocalizedPoint GpsOdometryLocalizer::on_gps(const GpsFix& fix) {
     if (const double gap = fix.time_s - last_fix_s_; gap <= config_.gps_timeout_s) {
       fix_gaps_.push_back(gap);
       if (fix_gaps_.size() > 5) fix_gaps_.pop_front();
+      takeover_s_ = takeover_s();  // read at every odometry step, so worked out once per fix
     }
     last_fix_s_ = fix.time_s;
   }
@@ -252,7 +257,7 @@ LocalizedPoint GpsOdometryLocalizer::on_odometry(const OdometryStep& step) {
   if (!odometry_.started()) return last_;
   // Recorded from the last good fix on (each fix restarts it), so that when GPS goes quiet the
   // odometry already holds every metre driven since; it is the output only after the timeout.
-  if (step.time_s - last_good_gps_s_ <= takeover_s()) {
+  if (step.time_s - last_good_gps_s_ <= takeover_s_) {
     odometry_.record(step);
     return last_;
   }

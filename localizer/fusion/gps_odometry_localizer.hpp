@@ -87,7 +87,8 @@ class GpsOdometryLocalizer {
   double last_good_gps_s_ = -1e18;
   double last_fix_s_ = -1e18;  // the last fix of any quality, for the receiver's interval...
   std::deque<double> fix_gaps_;  // ...its last gaps
-  [[nodiscard]] double takeover_s() const;
+  [[nodiscard]] double takeover_s() const;  // from fix_gaps_...
+  double takeover_s_ = 0;                   // ...as of the last fix
   // The last course over ground seen while moving, turned since by the odometry: a vehicle that
   // stopped keeps facing the way it drove, though the road alone cannot say which way that was.
   std::optional<double> course_deg_;
