@@ -120,7 +120,7 @@ void visit_arrays(Visitor&& v, auto& d) {
   v(d.restrictions.edges);
   v(d.restrictions.only);
   v(d.restrictions.mode);
-  v(d.restrictions.except_emergency);
+  v(d.restrictions.except);
   v(d.turns_in_edges);
   v(d.left_hand_traffic);
 }

@@ -15,19 +15,6 @@ std::string_view tag(const osmium::TagList& tags, const char* key) {
 
 }  // namespace
 
-bool except_names_emergency(std::string_view list) {
-  while (!list.empty()) {
-    const auto semi = list.find(';');
-    std::string_view item = list.substr(0, semi);
-    while (!item.empty() && item.front() == ' ') item.remove_prefix(1);
-    while (!item.empty() && item.back() == ' ') item.remove_suffix(1);
-    if (item == "emergency" || item == "psv") return true;
-    if (semi == std::string_view::npos) break;
-    list.remove_prefix(semi + 1);
-  }
-  return false;
-}
-
 bool read_restriction(const osmium::Relation& rel, std::vector<OsmRestriction>& restrictions) {
   const auto& t = rel.tags();
   if (tag(t, "type") != "restriction") return true;
@@ -43,7 +30,7 @@ bool read_restriction(const osmium::Relation& rel, std::vector<OsmRestriction>& 
   if (base.from_ways.empty() || base.to_ways.empty() || base.via_nodes.size() + (base.via_ways.empty() ? 0 : 1) != 1) {
     return false;
   }
-  base.except_emergency = except_names_emergency(tag(t, "except"));
+  base.except = except_classes(tag(t, "except"));
   static constexpr std::pair<const char*, RestrictionMode> kKeys[] = {
       {"restriction", RestrictionMode::all},
       {"restriction:motorcar", RestrictionMode::motorcar},
@@ -110,7 +97,7 @@ std::size_t RestrictionResolver::resolve(const OsmRestriction& r, TurnRestrictio
               to.push_back(f);
             }
             for (EdgeId f : pick_by_direction(r, e, std::move(to))) {
-              out.add({e, f}, r.only, r.mode, r.except_emergency);
+              out.add({e, f}, r.only, r.mode, r.except);
               ++added;
             }
           }
@@ -140,7 +127,7 @@ void RestrictionResolver::walk_via(const OsmRestriction& r, osmium::object_id_ty
     }
     for (EdgeId f : pick_by_direction(r, path.back(), std::move(to))) {
       path.push_back(f);
-      out.add(path, r.only, r.mode, r.except_emergency);
+      out.add(path, r.only, r.mode, r.except);
       ++added;
       path.pop_back();
     }

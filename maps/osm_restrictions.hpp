@@ -24,7 +24,7 @@ struct OsmRestriction {
   // in more than one direction, it picks the one meant; `any` (no_entry, no_exit) takes them all.
   enum class Direction : std::uint8_t { any, left, right, straight } direction = Direction::any;
   RestrictionMode mode = RestrictionMode::all;
-  bool except_emergency = false;
+  std::uint8_t except = 0;  // VehicleClass bits its `except` names
 };
 
 // Appends one OsmRestriction per restriction key a type=restriction relation carries
@@ -34,10 +34,6 @@ struct OsmRestriction {
 // restriction relation without from and to ways and exactly one via (a node, or ways); true
 // otherwise, including for relations that are not restrictions.
 bool read_restriction(const osmium::Relation& relation, std::vector<OsmRestriction>& out);
-
-// True when a ';'-list names an emergency vehicle: `except=emergency` or `except=psv` lifts the
-// restriction for an ambulance or a fire engine.
-bool except_names_emergency(std::string_view list);
 
 // The edge paths an OSM restriction names in the built graph: every from edge arriving at the via
 // node (or at the start of the via ways), through the via ways' edges in any order they connect,

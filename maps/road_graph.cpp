@@ -62,12 +62,13 @@ void validate(const RoadGraphData& d) {
             "roundabout edges unsorted or out of range");
   }
   const TurnRestrictions& r = d.restrictions;
-  require(r.first.size() == r.size() + 1 && r.mode.size() == r.size() && r.except_emergency.size() == r.size() &&
+  require(r.first.size() == r.size() + 1 && r.mode.size() == r.size() && r.except.size() == r.size() &&
               r.first.front() == 0 && r.first.back() == r.edges.size(),
           "turn restriction arrays differ in length");
   for (std::size_t i = 0; i < r.size(); ++i) {
     require(r.first[i + 1] >= r.first[i] && r.first[i + 1] - r.first[i] >= 2, "a turn restriction needs a from and a to edge");
     require(r.mode[i] <= static_cast<std::uint8_t>(RestrictionMode::hgv), "unknown turn restriction mode");
+    require(r.except[i] < (1u << kVehicleClassCount), "unknown vehicle class in a turn restriction's except");
   }
   for (std::size_t i = 0; i < r.size(); ++i) {
     for (auto j = r.first[i]; j < r.first[i + 1]; ++j) {

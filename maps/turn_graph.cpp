@@ -17,6 +17,18 @@ double bearing_deg(Point2 a, Point2 b) { return std::atan2(b.x_m - a.x_m, b.y_m 
 // A turn while the graph is built (`other` is its target, which may still be redirected to a copy).
 using Arc = TurnArc;
 
+// Forbids turn `a` for the restriction modes `modes`, unless the vehicle belongs to a class in
+// `except` (0: no except). Excepted bans on one arc keep the classes they all name.
+void add_ban(Arc& a, std::uint8_t modes, std::uint8_t except) {
+  if (modes == 0) return;
+  if (except == 0) {
+    a.bits = static_cast<std::uint16_t>(a.bits | modes);
+    return;
+  }
+  a.except_classes = a.ban_modes_excepted() != 0 ? static_cast<std::uint16_t>(a.except_classes & except) : except;
+  a.bits = static_cast<std::uint16_t>(a.bits | (modes << 6));
+}
+
 }  // namespace
 
 double leaving_bearing_deg(std::span<const Point2> pts) {
@@ -62,7 +74,7 @@ TurnGraph::TurnGraph(const RoadGraphData& d) : edge_count_(d.edge_head.size()) {
     bool dead_end = true;
     for (auto f = d.first_out[n]; f < d.first_out[n + 1]; ++f) dead_end = dead_end && EdgeId{f} == twin;
     for (auto f = d.first_out[n]; f < d.first_out[n + 1]; ++f) {
-      Arc a{f, 0, 0};
+      Arc a{f, 0, 0, 0};
       if (!turns_in_edges) {
         a.angle_deg = static_cast<std::int16_t>(std::lround(signed_turn_deg(arriving[e], leaving[f])));
         if (EdgeId{f} == twin) {
@@ -94,16 +106,21 @@ TurnGraph::TurnGraph(const RoadGraphData& d) : edge_count_(d.edge_head.size()) {
     }
     return nullptr;
   };
-  constexpr std::uint16_t kBanBits = 0x0fff;
   // An only_* restriction allows, at each step of its path, just the next edge. When one
   // restriction resolves to several paths (a way that runs both ways from the via node), the allowed
   // set at a state is the union of theirs, so these bans wait until every path is known.
-  std::map<std::pair<std::uint32_t, std::uint16_t>, std::vector<EdgeId>> only_allowed;
+  struct OnlyKey {
+    std::uint32_t vertex;
+    std::uint8_t modes;
+    std::uint8_t except;
+    auto operator<=>(const OnlyKey&) const = default;
+  };
+  std::map<OnlyKey, std::vector<EdgeId>> only_allowed;
   const TurnRestrictions& r = d.restrictions;
   for (std::size_t k = 0; k < r.size(); ++k) {
     const std::span<const EdgeId> path(r.edges.data() + r.first[k], r.first[k + 1] - r.first[k]);
-    const auto ban = static_cast<std::uint16_t>(r.except_emergency[k] != 0 ? mode_bit(RestrictionMode{r.mode[k]}) << 6
-                                                                          : mode_bit(RestrictionMode{r.mode[k]}));
+    const std::uint8_t modes = mode_bit(RestrictionMode{r.mode[k]});
+    const std::uint8_t except = r.except[k];
     const bool only = r.only[k] != 0;
     std::uint32_t cur = path[0].v;
     for (std::size_t i = 1; i < path.size(); ++i) {
@@ -112,9 +129,9 @@ TurnGraph::TurnGraph(const RoadGraphData& d) : edge_count_(d.edge_head.size()) {
       if (arc == nullptr) {
         throw MapError("inconsistent road graph: turn restriction " + std::to_string(k) + " names edges that do not meet");
       }
-      if (only) only_allowed[{cur, ban}].push_back(next);
+      if (only) only_allowed[{cur, modes, except}].push_back(next);
       if (i + 1 == path.size()) {
-        if (!only) arc->bits |= ban;
+        if (!only) add_ban(*arc, modes, except);
         break;
       }
       if (arc->other < m) {
@@ -137,8 +154,8 @@ TurnGraph::TurnGraph(const RoadGraphData& d) : edge_count_(d.edge_head.size()) {
     }
   }
   for (const auto& [where, allowed] : only_allowed) {
-    for (Arc& a : arcs_of(where.first)) {
-      if (std::find(allowed.begin(), allowed.end(), edge_of_vertex(a.other)) == allowed.end()) a.bits |= where.second;
+    for (Arc& a : arcs_of(where.vertex)) {
+      if (std::find(allowed.begin(), allowed.end(), edge_of_vertex(a.other)) == allowed.end()) add_ban(a, where.modes, where.except);
     }
   }
   // Failure links, shallow states first: a copy inherits the bans and redirects of the longest
@@ -161,7 +178,8 @@ TurnGraph::TurnGraph(const RoadGraphData& d) : edge_count_(d.edge_head.size()) {
     for (Arc& a : copies[c]) {
       const Arc* f = arc_onto(fallback, edge_of_vertex(a.other));
       if (f == nullptr) continue;
-      a.bits |= static_cast<std::uint16_t>(f->bits & kBanBits);
+      add_ban(a, f->ban_modes(), 0);
+      add_ban(a, f->ban_modes_excepted(), static_cast<std::uint8_t>(f->except_classes));
       if (a.other < m && f->other >= m) a.other = f->other;
     }
   }
@@ -179,7 +197,11 @@ TurnGraph::TurnGraph(const RoadGraphData& d) : edge_count_(d.edge_head.size()) {
   in_.resize(out_.size());
   std::vector<std::uint32_t> fill(first_in_.begin(), first_in_.end() - 1);
   for (std::uint32_t v = 0; v < vertices; ++v) {
-    for (auto i = first_out_[v]; i < first_out_[v + 1]; ++i) in_[fill[out_[i].other]++] = {v, out_[i].angle_deg, out_[i].bits};
+    for (auto i = first_out_[v]; i < first_out_[v + 1]; ++i) {
+      TurnArc a = out_[i];
+      a.other = v;
+      in_[fill[out_[i].other]++] = a;
+    }
   }
 
   copy_first_.assign(m + 1, 0);

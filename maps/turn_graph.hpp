@@ -19,15 +19,21 @@ struct RoadGraphData;
 // One turn, 8 bytes, stored twice: in its source's out-arcs (`other` = the target vertex) and in its
 // target's in-arcs (`other` = the source vertex), so that a search scanning either way reads one
 // contiguous run of memory. `bits`: the low 6 bits are the RestrictionMode bits of restrictions
-// forbidding the turn, the next 6 the same for restrictions whose `except` names emergency
-// vehicles, then kTurnUturn and kTurnDeadEnd.
+// forbidding the turn with no `except`, the next 6 the same for restrictions whose `except` names
+// some vehicle class, then kTurnUturn and kTurnDeadEnd. `except_classes` holds the VehicleClass bits
+// those excepted restrictions all name: where two excepted restrictions with different lists forbid
+// one turn (never seen in OSM data), it lifts them only for a vehicle both name, which errs towards
+// obeying a restriction, never towards breaking one.
 struct TurnArc {
   std::uint32_t other;
-  std::int16_t angle_deg;  // signed turn, right positive, from the end of one edge to the start of the next
+  // The signed turn, right positive, from the end of one edge to the start of the next; within
+  // [-180, 180], so 10 bits hold it and the except mask fits beside it in 8 bytes.
+  std::int16_t angle_deg : 10;
+  std::uint16_t except_classes : 6;
   std::uint16_t bits;
 
   [[nodiscard]] std::uint8_t ban_modes() const { return static_cast<std::uint8_t>(bits & 0x3f); }
-  [[nodiscard]] std::uint8_t ban_modes_except_emergency() const { return static_cast<std::uint8_t>((bits >> 6) & 0x3f); }
+  [[nodiscard]] std::uint8_t ban_modes_excepted() const { return static_cast<std::uint8_t>((bits >> 6) & 0x3f); }
   [[nodiscard]] bool uturn() const { return (bits & kTurnUturnBit) != 0; }
   [[nodiscard]] bool dead_end() const { return (bits & kTurnDeadEndBit) != 0; }
   // True for the common turn no rule touches: its cost is the angle's alone.

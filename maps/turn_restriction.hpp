@@ -1,6 +1,6 @@
 // OSM turn restrictions resolved onto the road graph's edges, in the profile-independent form the
 // graph and its cache keep: the edges of the forbidden (or only allowed) manoeuvre, which tag said
-// so, and whether an `except` names an emergency vehicle. A vehicle profile decides what binds it.
+// so, and which vehicle classes its `except` names. A vehicle profile decides what binds it.
 #pragma once
 
 #include <cstdint>
@@ -23,6 +23,27 @@ enum class RestrictionMode : std::uint8_t {
 };
 inline constexpr std::uint8_t mode_bit(RestrictionMode m) { return static_cast<std::uint8_t>(1u << static_cast<unsigned>(m)); }
 
+// The vehicle classes an `except=*` list may name, as bits of a mask. A profile lists the classes
+// its vehicle belongs to (an ambulance is a motorcar and an emergency vehicle; a fire engine an hgv
+// and an emergency vehicle), and an `except` naming any of them lifts the restriction for it.
+enum class VehicleClass : std::uint8_t {
+  motorcar = 0,
+  motor_vehicle = 1,
+  vehicle = 2,
+  emergency = 3,
+  hgv = 4,
+  psv = 5,
+};
+inline constexpr int kVehicleClassCount = 6;
+inline constexpr std::uint8_t class_bit(VehicleClass c) { return static_cast<std::uint8_t>(1u << static_cast<unsigned>(c)); }
+
+// The classes a ';'-list names ("psv;emergency"); values outside VehicleClass (bicycle, bus, ...)
+// name no class a profile can belong to and are ignored.
+std::uint8_t except_classes(std::string_view list);
+// The class a name stands for ("motorcar"), or false when it is not one.
+bool vehicle_class_from_name(std::string_view name, VehicleClass& out);
+std::string_view to_string(VehicleClass c);
+
 // Flat arrays (the cache stores them as they are). Restriction r forbids driving
 // edges[first[r] .. first[r+1]) in that order (from, via edges..., to): a via-node restriction has
 // two edges, a via-way one more. An `only_*` restriction instead forbids every other way out of the
@@ -32,15 +53,15 @@ struct TurnRestrictions {
   std::vector<EdgeId> edges;
   std::vector<std::uint8_t> only;             // 1 for only_*
   std::vector<std::uint8_t> mode;             // RestrictionMode
-  std::vector<std::uint8_t> except_emergency;  // 1 when `except` names emergency or psv
+  std::vector<std::uint8_t> except;  // VehicleClass bits its `except` names (0: none)
 
   [[nodiscard]] std::size_t size() const { return only.size(); }
-  void add(const std::vector<EdgeId>& path, bool is_only, RestrictionMode m, bool lifted_for_emergency) {
+  void add(const std::vector<EdgeId>& path, bool is_only, RestrictionMode m, std::uint8_t except_mask) {
     edges.insert(edges.end(), path.begin(), path.end());
     first.push_back(static_cast<std::uint32_t>(edges.size()));
     only.push_back(is_only ? 1 : 0);
     mode.push_back(static_cast<std::uint8_t>(m));
-    except_emergency.push_back(lifted_for_emergency ? 1 : 0);
+    except.push_back(except_mask);
   }
 };
 

@@ -58,7 +58,7 @@ class TravelCost {
   [[nodiscard]] double turn_s(const maps::TurnArc& a) const {
     if (a.plain()) return angle_cost_s_[static_cast<std::size_t>(a.angle_deg + 180)];
     if ((a.ban_modes() & profile_.restriction_modes) != 0 ||
-        (!profile_.emergency_exceptions && (a.ban_modes_except_emergency() & profile_.restriction_modes) != 0)) {
+        ((a.ban_modes_excepted() & profile_.restriction_modes) != 0 && (a.except_classes & profile_.except_classes) == 0)) {
       return kInfCost;
     }
     if (a.uturn()) {

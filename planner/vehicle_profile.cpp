@@ -54,6 +54,9 @@ VehicleProfile fire_engine_profile() {
   p.width_m = 2.55;
   p.weight_t = 15.0;
   p.restriction_modes |= maps::mode_bit(RestrictionMode::hgv);
+  // A 15 t truck: `except=motorcar` does not lift a restriction for it, `except=hgv` does.
+  p.except_classes = static_cast<std::uint8_t>((p.except_classes & ~maps::class_bit(maps::VehicleClass::motorcar)) |
+                                               maps::class_bit(maps::VehicleClass::hgv));
   // A 10 m rigid truck slows down more for a turn, and waits longer for a gap to cross.
   p.turn_penalty_s = 9.0;
   p.crossing_penalty_s = 4.0;
@@ -112,7 +115,19 @@ VehicleProfile profile_from_json(std::string_view text) {
       p.*(field->second) = number(value, field->first);
     } else if (key == "emergency_exceptions") {
       require(value.is_boolean(), "'emergency_exceptions' must be true or false");
-      p.emergency_exceptions = value.get<bool>();
+      require(!j.contains("except_classes"), "give 'except_classes' or the older 'emergency_exceptions', not both");
+      constexpr auto kEmergency = static_cast<std::uint8_t>(maps::class_bit(maps::VehicleClass::emergency) |
+                                                            maps::class_bit(maps::VehicleClass::psv));
+      p.except_classes = value.get<bool>() ? static_cast<std::uint8_t>(p.except_classes | kEmergency) : std::uint8_t{0};
+    } else if (key == "except_classes") {
+      require(value.is_array(), "'except_classes' must be an array of vehicle class names");
+      p.except_classes = 0;
+      for (const auto& c : value) {
+        maps::VehicleClass cls{};
+        require(c.is_string() && maps::vehicle_class_from_name(c.get<std::string>(), cls),
+                "unknown vehicle class " + c.dump() + " in except_classes (known: motorcar, motor_vehicle, vehicle, emergency, hgv, psv)");
+        p.except_classes |= maps::class_bit(cls);
+      }
     } else if (key == "uturn") {
       require(value == "dead_ends" || value == "anywhere", "'uturn' must be \"dead_ends\" or \"anywhere\"");
       p.uturn_policy = value == "anywhere" ? UturnPolicy::anywhere : UturnPolicy::dead_ends;
@@ -180,7 +195,11 @@ std::string profile_to_json(const VehicleProfile& p) {
   for (const auto& [name, mode] : kModes) {
     if ((p.restriction_modes & maps::mode_bit(mode)) != 0) j["restriction_modes"].push_back(name);
   }
-  j["emergency_exceptions"] = p.emergency_exceptions;
+  j["except_classes"] = nlohmann::json::array();
+  for (int c = 0; c < maps::kVehicleClassCount; ++c) {
+    const auto cls = static_cast<maps::VehicleClass>(c);
+    if ((p.except_classes & maps::class_bit(cls)) != 0) j["except_classes"].push_back(std::string(maps::to_string(cls)));
+  }
   j["uturn"] = p.uturn_policy == UturnPolicy::anywhere ? "anywhere" : "dead_ends";
   for (int c = 0; c < maps::kRoadClassCount; ++c) {
     j["speed_factor"][std::string(maps::to_string(static_cast<maps::RoadClass>(c)))] = p.speed_factor[static_cast<std::size_t>(c)];

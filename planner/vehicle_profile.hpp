@@ -32,13 +32,17 @@ struct VehicleProfile {
   double height_m = 2.9;
   double width_m = 2.3;
   double weight_t = 4.6;
-  // Which `restriction:<mode>` keys bind it (maps::mode_bit), and whether an `except` naming
-  // emergency or psv lifts a restriction for it.
+  // Which `restriction:<mode>` keys bind it (maps::mode_bit), and the vehicle classes it belongs to
+  // (maps::class_bit): an `except` naming one of them lifts a restriction for it. An ambulance is a
+  // motorcar, a fire engine an hgv; both are emergency vehicles, and `except=psv` lifts a
+  // restriction for them too (bus gates and lanes are open to emergency services).
   std::uint8_t restriction_modes = maps::mode_bit(maps::RestrictionMode::all) | maps::mode_bit(maps::RestrictionMode::motorcar) |
                                    maps::mode_bit(maps::RestrictionMode::motor_vehicle) |
                                    maps::mode_bit(maps::RestrictionMode::vehicle) |
                                    maps::mode_bit(maps::RestrictionMode::emergency);
-  bool emergency_exceptions = true;
+  std::uint8_t except_classes = maps::class_bit(maps::VehicleClass::motorcar) | maps::class_bit(maps::VehicleClass::motor_vehicle) |
+                                maps::class_bit(maps::VehicleClass::vehicle) | maps::class_bit(maps::VehicleClass::emergency) |
+                                maps::class_bit(maps::VehicleClass::psv);
   // Turn cost: turn_penalty_s × (1 − cos θ) / 2 for a turn of θ (a right angle costs half of it), plus
   // crossing_penalty_s for a turn across oncoming traffic (a left turn where traffic keeps right).
   double turn_penalty_s = 6.0;
@@ -62,8 +66,10 @@ VehicleProfile builtin_profile(std::string_view name);
 
 // JSON: every field optional over the ambulance's defaults, or {"base": "fire_engine", ...}.
 //   {"name", "base", "vmax_kmh", "height_m", "width_m", "weight_t", "restriction_modes": ["motorcar", ...],
-//    "emergency_exceptions", "turn_penalty_s", "crossing_penalty_s", "uturn": "dead_ends"|"anywhere",
+//    "except_classes": ["motorcar", "emergency", ...], "turn_penalty_s", "crossing_penalty_s", "uturn": "dead_ends"|"anywhere",
 //    "uturn_penalty_s", "speed_factor": {"residential": 0.9, ...}}
+// "emergency_exceptions" (the key before except_classes) is still read: false means no `except`
+// lifts a restriction for the vehicle, true adds emergency and psv to its classes.
 // Throws ProfileError naming the field for malformed JSON, an unknown key, a wrong type, or a value
 // out of range.
 VehicleProfile profile_from_json(std::string_view json);

@@ -66,7 +66,7 @@ TEST(GraphCache, RoundTripKeepsTheTurnModel) {
   const RoadGraph back = read_graph_cache(file);
   EXPECT_EQ(back.data().restrictions.edges, g.data().restrictions.edges);
   EXPECT_EQ(back.data().restrictions.mode, g.data().restrictions.mode);
-  EXPECT_EQ(back.data().restrictions.except_emergency, g.data().restrictions.except_emergency);
+  EXPECT_EQ(back.data().restrictions.except, g.data().restrictions.except);
   ASSERT_EQ(back.edge_limits().size(), 1u);
   EXPECT_FLOAT_EQ(back.edge_limits()[0].max_height_m, 3.2f);
   EXPECT_TRUE(back.on_roundabout(b));
@@ -85,7 +85,7 @@ TEST(GraphCache, InconsistentRestrictionsAreRejected) {
     d.restrictions.edges = std::move(edges);
     d.restrictions.only.assign(n, 0);
     d.restrictions.mode.assign(n, 0);
-    d.restrictions.except_emergency.assign(n, 0);
+    d.restrictions.except.assign(n, 0);
     return d;
   };
   const EdgeId e0{0};

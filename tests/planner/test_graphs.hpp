@@ -51,8 +51,11 @@ inline maps::RoadGraph with_random_restrictions(const maps::RoadGraph& g, std::u
     }
     if (path.size() < 2) continue;
     const auto mode = static_cast<maps::RestrictionMode>(std::uniform_int_distribution<int>(0, 5)(rng));
-    d.restrictions.add(path, std::uniform_int_distribution<int>(0, 3)(rng) == 0, mode,
-                       std::uniform_int_distribution<int>(0, 3)(rng) == 0);
+    // One in four names an `except`: any set of vehicle classes, so that overlapping restrictions
+    // with different lists meet on one turn.
+    const bool excepted = std::uniform_int_distribution<int>(0, 3)(rng) == 0;
+    const auto except = static_cast<std::uint8_t>(excepted ? std::uniform_int_distribution<int>(1, 63)(rng) : 0);
+    d.restrictions.add(path, std::uniform_int_distribution<int>(0, 3)(rng) == 0, mode, except);
   }
   return maps::RoadGraph(std::move(d));
 }
@@ -76,7 +79,7 @@ inline VehicleProfile oracle_profile(std::uint64_t seed, double vmax_mps) {
   if (seed % 4 == 3) {
     p.uturn_policy = UturnPolicy::anywhere;
     p.uturn_penalty_s = 12.0;
-    p.emergency_exceptions = false;
+    p.except_classes = 0;
   }
   p.vmax_mps = vmax_mps;
   return p;

@@ -16,7 +16,7 @@ namespace {
 
 bool binds(const VehicleProfile& p, const maps::TurnRestrictions& r, std::size_t k) {
   const bool mode = (p.restriction_modes & maps::mode_bit(maps::RestrictionMode{r.mode[k]})) != 0;
-  return mode && !(r.except_emergency[k] != 0 && p.emergency_exceptions);
+  return mode && (r.except[k] & p.except_classes) == 0;
 }
 
 // Empty when `driven` obeys every binding restriction; else which one it breaks and where.
@@ -55,7 +55,7 @@ maps::RoadGraph restricted_grid(std::uint64_t seed) {
       if (std::find(only_from.begin(), only_from.end(), path[0]) != only_from.end()) continue;
       only_from.push_back(path[0]);
     }
-    d.restrictions.add(path, all.only[k] != 0, maps::RestrictionMode{all.mode[k]}, all.except_emergency[k] != 0);
+    d.restrictions.add(path, all.only[k] != 0, maps::RestrictionMode{all.mode[k]}, all.except[k]);
   }
   return maps::RoadGraph(std::move(d));
 }

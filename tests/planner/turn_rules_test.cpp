@@ -141,12 +141,29 @@ TEST(TurnRules, ExceptNamingEmergencyOrPsvLiftsTheRestriction) {
                                          {{"restriction", "no_left_turn"}, {"except", except}})});
     EXPECT_EQ(south_to_west(g).ways, kLeftAtTwo) << except;
     VehicleProfile strict = ambulance_profile();
-    strict.emergency_exceptions = false;
+    strict.except_classes = 0;
     EXPECT_NE(south_to_west(g, strict).ways, kLeftAtTwo) << except;
   }
   const auto g = plus_map({restriction({{'w', kSouth, "from"}, {'n', 2, "via"}, {'w', kWest, "to"}},
                                        {{"restriction", "no_left_turn"}, {"except", "bicycle"}})});
   EXPECT_NE(south_to_west(g).ways, kLeftAtTwo);
+}
+
+// An `except` lifts a ban for the classes the vehicle belongs to: the ambulance is a motorcar, the
+// fire engine an hgv (OSRM's car takes except=motorcar|motor_vehicle|vehicle the same way).
+TEST(TurnRules, ExceptLiftsTheBanForTheVehicleClassesItNames) {
+  struct Case {
+    const char* except;
+    bool ambulance_lifted;
+    bool fire_engine_lifted;
+  };
+  for (const Case& c : {Case{"motorcar", true, false}, Case{"hgv", false, true}, Case{"motor_vehicle", true, true},
+                        Case{"bus;bicycle", false, false}, Case{"hgv; motorcar", true, true}}) {
+    const auto g = plus_map({restriction({{'w', kSouth, "from"}, {'n', 2, "via"}, {'w', kWest, "to"}},
+                                         {{"restriction", "no_left_turn"}, {"except", c.except}})});
+    EXPECT_EQ(south_to_west(g).ways == kLeftAtTwo, c.ambulance_lifted) << c.except;
+    EXPECT_EQ(south_to_west(g, fire_engine_profile()).ways == kLeftAtTwo, c.fire_engine_lifted) << c.except;
+  }
 }
 
 TEST(TurnRules, TurnsBannedOnRedOnlyStayOpen) {

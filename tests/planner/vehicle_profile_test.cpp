@@ -54,6 +54,28 @@ TEST(VehicleProfile, BadJsonIsAClearError) {
   EXPECT_THROW((void)load_profile("/nonexistent/profile.json"), ProfileError);
 }
 
+TEST(VehicleProfile, ExceptClassesFromJson) {
+  using maps::class_bit;
+  using maps::VehicleClass;
+  EXPECT_EQ(profile_from_json(R"({"except_classes": ["hgv", "emergency"]})").except_classes,
+            class_bit(VehicleClass::hgv) | class_bit(VehicleClass::emergency));
+  EXPECT_EQ(profile_from_json(R"({"except_classes": []})").except_classes, 0);
+  // The older key: false lifts nothing, true adds emergency and psv to the base's classes.
+  EXPECT_EQ(profile_from_json(R"({"emergency_exceptions": false})").except_classes, 0);
+  EXPECT_EQ(profile_from_json(R"({"emergency_exceptions": true})").except_classes, ambulance_profile().except_classes);
+  auto error_of = [](const char* json) {
+    try {
+      (void)profile_from_json(json);
+    } catch (const ProfileError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(error_of(R"({"except_classes": ["bus"]})").find("unknown vehicle class \"bus\""), std::string::npos);
+  EXPECT_NE(error_of(R"({"except_classes": "hgv"})").find("array"), std::string::npos);
+  EXPECT_NE(error_of(R"({"except_classes": [], "emergency_exceptions": true})").find("not both"), std::string::npos);
+}
+
 TEST(VehicleProfile, SpeedFactorSlowsItsRoadClassOnly) {
   const auto g = testing::diamond();  // residential roads
   const EdgeId ab = testing::edge_from_to(g, 1, 2);
