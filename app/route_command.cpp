@@ -73,7 +73,8 @@ void run_route(const RouteOptions& o) {
 
   const maps::RoadGraph graph = load_map_from_options(o.map);
   const maps::EdgeSnapper snapper(graph);
-  const maps::SnapOptions snap{o.max_snap_m};
+  maps::SnapOptions snap{o.max_snap_m};
+  snap.skip_ferries = true;
   auto snap_or_explain = [&](maps::LatLon p, const char* which) {
     try {
       return snapper.snap(p, snap);
@@ -99,7 +100,7 @@ void run_route(const RouteOptions& o) {
   planner::Route route;
   planner::plan_nearest_or_main(snapper, graph, from, s, to, t, snap, [&](const maps::SnapResult& a, const maps::SnapResult& b) {
     const auto starts = planner::points_from_snap(graph, a, planner::PointRole::start);
-    const auto goals = planner::points_from_snap(graph, b, planner::PointRole::goal);
+    const auto goals = planner::at_same_node(graph, a, b) ? starts : planner::points_from_snap(graph, b, planner::PointRole::goal);
     if (algo == planner::Algorithm::dstar_lite) {
       planner::DStarLite dstar(cost, starts, goals);
       dstar.replan();

@@ -129,17 +129,21 @@ SnapResult EdgeSnapper::snap_local(Point2 p, const SnapOptions& options) const {
     throw SnapError(SnapError::Reason::outside_map, "coordinate is outside the map");
   }
   std::vector<std::pair<BgSegment, std::uint32_t>> found;
-  if (options.main_component_only) {
-    const auto on_main = [&](const std::pair<BgSegment, std::uint32_t>& v) {
-      return graph_.in_main_component(index_->pieces[v.second].edge);
+  if (options.main_component_only || options.skip_ferries) {
+    const auto wanted = [&](const std::pair<BgSegment, std::uint32_t>& v) {
+      const EdgeId e = index_->pieces[v.second].edge;
+      return (!options.main_component_only || graph_.in_main_component(e)) &&
+             (!options.skip_ferries || graph_.road_class(e) != RoadClass::ferry);
     };
-    index_->tree.query(bgi::nearest(BgPoint{p.x_m, p.y_m}, 1) && bgi::satisfies(on_main), std::back_inserter(found));
+    index_->tree.query(bgi::nearest(BgPoint{p.x_m, p.y_m}, 1) && bgi::satisfies(wanted), std::back_inserter(found));
   } else {
     index_->tree.query(bgi::nearest(BgPoint{p.x_m, p.y_m}, 1), std::back_inserter(found));
   }
   if (found.empty()) {
     throw SnapError(SnapError::Reason::outside_map,
-                    options.main_component_only ? "the map's main component has no roads" : "the map has no roads");
+                    options.main_component_only ? "the map's main component has no roads"
+                    : options.skip_ferries      ? "the map has no roads but ferries"
+                                                : "the map has no roads");
   }
 
   const auto& [segment, piece_id] = found.front();

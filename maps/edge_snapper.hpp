@@ -11,6 +11,10 @@ namespace corridor::maps {
 struct SnapOptions {
   double max_distance_m = 200.0;  // farther than this from every road is an error
   bool main_component_only = false;  // only roads of the graph's main component (RoadGraph)
+  // Only roads a trip may start or end on, not ferries: a click beside a ferry berth means the quay
+  // road, as OSRM's car never starts or stops on a ferry. A vehicle's own position fix keeps them
+  // (it may be riding one).
+  bool skip_ferries = false;
 };
 
 struct SnapResult {

@@ -62,7 +62,9 @@ class RoadCollector : public osmium::handler::Handler {
     const auto& t = way.tags();
     WayTags wt;
     wt.highway = tag(t, "highway");
-    if (wt.highway.empty()) return;
+    wt.route = tag(t, "route");
+    if (wt.highway.empty() && wt.route.empty()) return;
+    wt.duration = tag(t, "duration");
     wt.junction = tag(t, "junction");
     wt.oneway = tag(t, "oneway");
     wt.oneway_emergency = tag(t, "oneway:emergency");
@@ -214,8 +216,19 @@ RoadGraph import_osm(const std::filesystem::path& path, const OsmImportOptions& 
   };
   std::vector<PendingSignal> signal_marks;
 
-  for (const KeptWay& way : c.ways) {
+  for (KeptWay& way : c.ways) {
     const std::uint32_t end = way.first_ref + way.ref_count;
+    if (way.rules.duration_s > 0) {
+      // A ferry's duration is for the whole crossing: its speed is the way's length over it, so
+      // that each piece of the way takes its share (OSRM spreads it the same way).
+      double length = 0.0;
+      for (std::uint32_t k = way.first_ref + 1; k < end; ++k) {
+        if (!c.locations[k - 1].valid() || !c.locations[k].valid()) continue;
+        length += distance_m(projection.to_local({c.locations[k - 1].lat(), c.locations[k - 1].lon()}),
+                             projection.to_local({c.locations[k].lat(), c.locations[k].lon()}));
+      }
+      if (length > 0) way.rules.forward_speed_kmh = way.rules.backward_speed_kmh = length / way.rules.duration_s / kKmhToMps;
+    }
     std::uint32_t i = way.first_ref;
     while (i < end) {
       // A run of consecutive nodes with known locations; missing nodes split the way.

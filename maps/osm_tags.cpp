@@ -229,17 +229,71 @@ double default_speed_kmh(RoadClass c) {
     case RoadClass::service: return 20;
     case RoadClass::emergency_access: return 20;
     case RoadClass::synthetic: return 50;
+    case RoadClass::ferry: return 5;
   }
   return 30;
 }
 
+std::optional<double> parse_duration_s(std::string_view raw) {
+  const std::string v = lower(trim(raw));
+  if (v.empty()) return std::nullopt;
+  double total = 0.0;
+  if (v.front() == 'p') {
+    // ISO 8601: P[nD][T[nH][nM][nS]].
+    bool in_time = false;
+    std::size_t i = 1;
+    bool any = false;
+    while (i < v.size()) {
+      if (v[i] == 't') {
+        in_time = true;
+        ++i;
+        continue;
+      }
+      double n = 0.0;
+      const auto [ptr, ec] = std::from_chars(v.data() + i, v.data() + v.size(), n);
+      if (ec != std::errc{} || ptr == v.data() + v.size() || !std::isfinite(n) || n < 0) return std::nullopt;
+      const char unit = *ptr;
+      i = static_cast<std::size_t>(ptr - v.data()) + 1;
+      if (unit == 'd' && !in_time) total += n * 86400.0;
+      else if (unit == 'h' && in_time) total += n * 3600.0;
+      else if (unit == 'm' && in_time) total += n * 60.0;
+      else if (unit == 's' && in_time) total += n;
+      else return std::nullopt;
+      any = true;
+    }
+    if (!any) return std::nullopt;
+  } else {
+    // hh:mm[:ss], or plain minutes.
+    double parts[3] = {0, 0, 0};
+    int count = 0;
+    std::string_view rest(v);
+    while (true) {
+      if (count == 3) return std::nullopt;
+      double n = 0.0;
+      const auto [ptr, ec] = std::from_chars(rest.data(), rest.data() + rest.size(), n);
+      if (ec != std::errc{} || !std::isfinite(n) || n < 0) return std::nullopt;
+      parts[count++] = n;
+      rest.remove_prefix(static_cast<std::size_t>(ptr - rest.data()));
+      if (rest.empty()) break;
+      if (rest.front() != ':') return std::nullopt;
+      rest.remove_prefix(1);
+    }
+    total = count == 1 ? parts[0] * 60.0 : parts[0] * 3600.0 + parts[1] * 60.0 + parts[2];
+  }
+  if (!(total > 0.0) || !std::isfinite(total)) return std::nullopt;
+  return total;
+}
+
 std::optional<WayRules> interpret_way(const WayTags& t) {
-  if (t.highway.empty() || t.area == "yes") return std::nullopt;
+  const bool ferry = t.route == "ferry" || t.route == "shuttle_train";
+  if ((t.highway.empty() && !ferry) || t.area == "yes") return std::nullopt;
   const bool emergency_allowed = is_one_of(t.emergency, {"yes", "designated", "official", "permissive"});
   if (t.emergency == "no") return std::nullopt;
 
   WayRules rules;
-  if (auto cls = road_class_from_highway(t.highway)) {
+  if (ferry) {
+    rules.road_class = RoadClass::ferry;
+  } else if (auto cls = road_class_from_highway(t.highway)) {
     rules.road_class = *cls;
   } else if (emergency_allowed) {
     rules.road_class = RoadClass::emergency_access;
@@ -262,8 +316,8 @@ std::optional<WayRules> interpret_way(const WayTags& t) {
   }
   OnewayRule oneway = parse_oneway(oneway_tag);
   if (oneway == OnewayRule::unspecified) {
-    const bool implied = t.junction == "roundabout" || t.junction == "circular" ||
-                         rules.road_class == RoadClass::motorway;
+    const bool implied = !ferry && (t.junction == "roundabout" || t.junction == "circular" ||
+                                    rules.road_class == RoadClass::motorway);
     oneway = implied ? OnewayRule::forward : OnewayRule::both;
   }
   if (oneway == OnewayRule::unusable) return std::nullopt;
@@ -281,9 +335,17 @@ std::optional<WayRules> interpret_way(const WayTags& t) {
   }
   if (!rules.forward && !rules.backward) return std::nullopt;
 
-  const double fallback = parse_maxspeed_kmh(t.maxspeed).value_or(default_speed_kmh(rules.road_class));
-  rules.forward_speed_kmh = parse_maxspeed_kmh(t.maxspeed_forward).value_or(fallback);
-  rules.backward_speed_kmh = parse_maxspeed_kmh(t.maxspeed_backward).value_or(fallback);
+  if (ferry) {
+    // A boat's or a train's pace, not a speed limit: maxspeed does not apply.
+    constexpr double kShuttleTrainKmh = 10.0;
+    rules.forward_speed_kmh = rules.backward_speed_kmh =
+        t.route == "shuttle_train" ? kShuttleTrainKmh : default_speed_kmh(RoadClass::ferry);
+    rules.duration_s = parse_duration_s(t.duration).value_or(0.0);
+  } else {
+    const double fallback = parse_maxspeed_kmh(t.maxspeed).value_or(default_speed_kmh(rules.road_class));
+    rules.forward_speed_kmh = parse_maxspeed_kmh(t.maxspeed_forward).value_or(fallback);
+    rules.backward_speed_kmh = parse_maxspeed_kmh(t.maxspeed_backward).value_or(fallback);
+  }
   rules.max_height_m = parse_length_m(t.maxheight).value_or(0.0);
   rules.max_width_m = parse_length_m(t.maxwidth).value_or(0.0);
   rules.max_weight_t = parse_weight_t(t.maxweight).value_or(0.0);

@@ -36,6 +36,9 @@ struct WayTags {
   std::string_view access_forward, access_backward;
   // Physical limits.
   std::string_view maxheight, maxwidth, maxweight;
+  // Ferries: route=ferry|shuttle_train, and the crossing's duration ("0:45", "1:30:00", "PT45M").
+  std::string_view route;
+  std::string_view duration;
 };
 
 // The tags of a node that may stop a vehicle on the way through it.
@@ -63,6 +66,9 @@ struct WayRules {
   double max_width_m = 0.0;
   double max_weight_t = 0.0;
   bool roundabout = false;  // junction=roundabout|circular
+  // A ferry's crossing time from its duration tag, for the whole way; 0 when it has none (the
+  // importer then keeps the class's speed). The importer spreads it over the way by length.
+  double duration_s = 0.0;
 };
 
 // Rules for an emergency vehicle, or nullopt when it may not use the way at all.
@@ -80,7 +86,15 @@ struct WayRules {
 //  - oneway:emergency, then oneway:motorcar, oneway:motor_vehicle, oneway:vehicle override oneway;
 //    *:forward / *:backward access (motorcar, motor_vehicle, vehicle, access, most specific first)
 //    closes one direction.
+//  - route=ferry|shuttle_train (with or without a highway tag) is class ferry, as OSRM's car
+//    profile reads it: the same access rules, no implied oneway, 5 km/h for a ferry and 10 km/h for
+//    a shuttle train unless its duration says otherwise. Whether a vehicle boards ferries at all is
+//    its profile's choice.
 std::optional<WayRules> interpret_way(const WayTags& tags);
+
+// A duration in seconds: "hh:mm", "hh:mm:ss", a number of minutes, or ISO 8601 ("PT1H30M",
+// "P1DT2H"). nullopt for anything else, or for zero.
+std::optional<double> parse_duration_s(std::string_view value);
 
 // A length in metres: "3.5", "3.5 m", "12 ft", "11'6\"". nullopt for "default", "none",
 // "below_default" and anything unparsable (no limit is assumed then).

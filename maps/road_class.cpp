@@ -34,7 +34,11 @@ std::string_view to_string(RoadClass c) {
   for (const auto& [name, cls] : kHighwayClasses) {
     if (cls == c) return name;
   }
-  return c == RoadClass::emergency_access ? "emergency_access" : "synthetic";
+  switch (c) {
+    case RoadClass::emergency_access: return "emergency_access";
+    case RoadClass::ferry: return "ferry";
+    default: return "synthetic";
+  }
 }
 
 }  // namespace corridor::maps

@@ -1,4 +1,5 @@
-// The road classes an emergency vehicle may use, as in OSM's highway=* values.
+// The road classes an emergency vehicle may use, as in OSM's highway=* values, and the ferries
+// (route=ferry|shuttle_train) that carry vehicles across water or through a tunnel.
 #pragma once
 
 #include <cstdint>
@@ -24,9 +25,10 @@ enum class RoadClass : std::uint8_t {
   service,
   emergency_access,  // any other highway=* explicitly open to emergency vehicles
   synthetic,         // generated graphs
+  ferry,             // route=ferry or route=shuttle_train: the vehicle rides, at the crossing's pace
 };
 
-inline constexpr int kRoadClassCount = 16;
+inline constexpr int kRoadClassCount = 17;
 
 // The class for a highway=* value, or nullopt when that value is not a drivable class.
 std::optional<RoadClass> road_class_from_highway(std::string_view highway);

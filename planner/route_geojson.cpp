@@ -23,6 +23,7 @@ nlohmann::json steps_to_json(const maps::RoadGraph& graph, const Route& route) {
                    {"ref", s.ref},
                    {"distance_m", round1(s.distance_m)},
                    {"duration_s", round1(s.duration_s)},
+                   {"mode", s.ferry ? "ferry" : "driving"},
                    {"maneuver", std::move(maneuver)}});
   }
   return out;

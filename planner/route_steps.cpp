@@ -81,6 +81,7 @@ std::vector<RouteStep> route_steps(const maps::RoadGraph& g, const Route& route,
   depart.name = g.name(route.edges[0]);
   depart.ref = g.ref(route.edges[0]);
   depart.maneuver = ManeuverType::depart;
+  depart.ferry = g.road_class(route.edges[0]) == maps::RoadClass::ferry;
   depart.location = g.point_along(route.edges[0], route.start.offset_m);
   steps.push_back(depart);
   for (std::size_t i = 0; i < n; ++i) {
@@ -106,7 +107,8 @@ std::vector<RouteStep> route_steps(const maps::RoadGraph& g, const Route& route,
         const double turn = turn_between(g, in, out);
         const bool renamed = g.name(in) != g.name(out) || g.ref(in) != g.ref(out);
         const bool sharp = std::abs(turn) >= options.continue_turn_deg;
-        if (renamed || sharp) {
+        const bool boards_or_leaves = (g.road_class(in) == maps::RoadClass::ferry) != (g.road_class(out) == maps::RoadClass::ferry);
+        if (renamed || sharp || boards_or_leaves) {
           RouteStep s;
           s.name = g.name(out);
           s.ref = g.ref(out);
@@ -116,6 +118,7 @@ std::vector<RouteStep> route_steps(const maps::RoadGraph& g, const Route& route,
                        : s.modifier == TurnModifier::straight ? ManeuverType::new_name
                                                                : ManeuverType::turn;
           s.location = g.position(g.tail(out));
+          s.ferry = g.road_class(out) == maps::RoadClass::ferry;
           steps.push_back(s);
         }
       }
@@ -127,6 +130,7 @@ std::vector<RouteStep> route_steps(const maps::RoadGraph& g, const Route& route,
   arrive.name = g.name(route.edges.back());
   arrive.ref = g.ref(route.edges.back());
   arrive.maneuver = ManeuverType::arrive;
+  arrive.ferry = g.road_class(route.edges.back()) == maps::RoadClass::ferry;
   arrive.location = g.point_along(route.edges.back(), route.goal.offset_m);
   steps.push_back(arrive);
   return steps;

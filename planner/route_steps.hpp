@@ -27,6 +27,7 @@ struct RouteStep {
   maps::Point2 location;  // where the maneuver happens
   double turn_deg = 0;    // signed turn angle at the maneuver, right positive
   int exit = 0;           // for a roundabout: take the exit-th exit (1 = the first)
+  bool ferry = false;     // the step rides a ferry or shuttle train (OSRM's mode "ferry")
 };
 
 struct StepOptions {
@@ -37,7 +38,8 @@ struct StepOptions {
 // The modifier for a signed turn angle (right positive, degrees in (-180, 180]).
 TurnModifier modifier_for_turn(double turn_deg);
 
-// Depart, one step per street (or per sharp turn on one street), arrive. A roundabout is one step,
+// Depart, one step per street (or per sharp turn on one street, or per boarding or leaving a
+// ferry), arrive. A roundabout is one step,
 // "roundabout" with the exit to take, named after the road it leaves by, as OSRM gives it. Empty for
 // a route not found.
 std::vector<RouteStep> route_steps(const maps::RoadGraph& graph, const Route& route, const StepOptions& options = {});

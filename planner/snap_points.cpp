@@ -11,6 +11,11 @@ NodeId node_at_snap(const maps::RoadGraph& graph, const maps::SnapResult& snap) 
   return NodeId{};
 }
 
+bool at_same_node(const maps::RoadGraph& graph, const maps::SnapResult& a, const maps::SnapResult& b) {
+  const NodeId n = node_at_snap(graph, a);
+  return n.valid() && n == node_at_snap(graph, b);
+}
+
 std::vector<EdgePoint> points_from_snap(const maps::RoadGraph& graph, const maps::SnapResult& snap, PointRole role) {
   if (const NodeId n = node_at_snap(graph, snap); n.valid()) {
     std::vector<EdgePoint> at_node;

@@ -27,6 +27,12 @@ std::vector<EdgePoint> points_from_snap(const maps::RoadGraph& graph, const maps
 // The node a snapped coordinate lies on (within kAtNodeM of an end of its edge), or invalid.
 NodeId node_at_snap(const maps::RoadGraph& graph, const maps::SnapResult& snap);
 
+// True when both snaps lie at the same node. The goal is then where the start already is: plan to
+// the start's own points, which gives an empty route. The node's in-edges, the goal points of a
+// junction, would send a start that leaves the node out and back, round a block or to the far
+// dead end to turn (a 1 km loop from a dead end to itself).
+bool at_same_node(const maps::RoadGraph& graph, const maps::SnapResult& a, const maps::SnapResult& b);
+
 // A component of fewer nodes is small (OSRM's default, `--small-component-size`). A small largest
 // component is taken for the main one only when no other is as large: on a clip of a few streets
 // cut at its border, the network they mostly form; on two separate test streets of equal size,

@@ -34,6 +34,13 @@ TravelCost::TravelCost(const maps::RoadGraph& graph, const CostOverlay& overlay,
     if (blocked_.empty()) blocked_.assign(graph.edge_count(), 0);
     blocked_[l.edge.index()] = 1;
   }
+  if (!profile_.ferries) {
+    for (EdgeId e : graph.edges()) {
+      if (graph.road_class(e) != maps::RoadClass::ferry) continue;
+      if (blocked_.empty()) blocked_.assign(graph.edge_count(), 0);
+      blocked_[e.index()] = 1;
+    }
+  }
 }
 
 std::pair<double, std::uint32_t> TravelCost::turn_onto(std::uint32_t from, EdgeId next) const {

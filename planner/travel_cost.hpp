@@ -36,7 +36,8 @@ class TravelCost {
   // congestion only slows a vehicle down. A factor below 1 (traffic measured faster than the legal
   // speed) counts as 1, which keeps free flow at the legal speed a lower bound of every edge's
   // cost, as the landmark heuristic requires.
-  // An edge the vehicle does not fit (maxheight, maxwidth, maxweight) costs kInfCost.
+  // An edge the vehicle does not fit (maxheight, maxwidth, maxweight), or a ferry it does not
+  // board, costs kInfCost.
   [[nodiscard]] double running_time_s(EdgeId e) const {
     if (!blocked_.empty() && blocked_[e.index()] != 0) return kInfCost;
     double speed = graph_->speed_mps(e);

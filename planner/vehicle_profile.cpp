@@ -128,6 +128,9 @@ VehicleProfile profile_from_json(std::string_view text) {
                 "unknown vehicle class " + c.dump() + " in except_classes (known: motorcar, motor_vehicle, vehicle, emergency, hgv, psv)");
         p.except_classes |= maps::class_bit(cls);
       }
+    } else if (key == "ferries") {
+      require(value.is_boolean(), "'ferries' must be true or false");
+      p.ferries = value.get<bool>();
     } else if (key == "uturn") {
       require(value == "dead_ends" || value == "anywhere", "'uturn' must be \"dead_ends\" or \"anywhere\"");
       p.uturn_policy = value == "anywhere" ? UturnPolicy::anywhere : UturnPolicy::dead_ends;
@@ -200,6 +203,7 @@ std::string profile_to_json(const VehicleProfile& p) {
     const auto cls = static_cast<maps::VehicleClass>(c);
     if ((p.except_classes & maps::class_bit(cls)) != 0) j["except_classes"].push_back(std::string(maps::to_string(cls)));
   }
+  j["ferries"] = p.ferries;
   j["uturn"] = p.uturn_policy == UturnPolicy::anywhere ? "anywhere" : "dead_ends";
   for (int c = 0; c < maps::kRoadClassCount; ++c) {
     j["speed_factor"][std::string(maps::to_string(static_cast<maps::RoadClass>(c)))] = p.speed_factor[static_cast<std::size_t>(c)];

@@ -49,6 +49,10 @@ struct VehicleProfile {
   double crossing_penalty_s = 3.0;
   UturnPolicy uturn_policy = UturnPolicy::dead_ends;
   double uturn_penalty_s = 30.0;
+  // Whether it boards ferries and shuttle trains (class ferry). Both shipped profiles do, as OSRM's
+  // car does: on an island the ferry is the only way. A service whose boats take no vehicles, or
+  // whose crews must never be routed onto one, sets it false.
+  bool ferries = true;
   // Multiplies the legal speed per road class (before vmax caps it): an emergency vehicle with
   // lights and siren runs a little above the limit on main roads, slower on narrow residential ones.
   std::array<double, maps::kRoadClassCount> speed_factor = [] {
@@ -66,7 +70,7 @@ VehicleProfile builtin_profile(std::string_view name);
 
 // JSON: every field optional over the ambulance's defaults, or {"base": "fire_engine", ...}.
 //   {"name", "base", "vmax_kmh", "height_m", "width_m", "weight_t", "restriction_modes": ["motorcar", ...],
-//    "except_classes": ["motorcar", "emergency", ...], "turn_penalty_s", "crossing_penalty_s", "uturn": "dead_ends"|"anywhere",
+//    "except_classes": ["motorcar", "emergency", ...], "ferries", "turn_penalty_s", "crossing_penalty_s", "uturn": "dead_ends"|"anywhere",
 //    "uturn_penalty_s", "speed_factor": {"residential": 0.9, ...}}
 // "emergency_exceptions" (the key before except_classes) is still read: false means no `except`
 // lifts a restriction for the vehicle, true adds emergency and psv to its classes.

@@ -312,13 +312,21 @@ void DispatchService::publish_route(Mission& m, const std::string& reason, doubl
   announce_route(m, reason, now_s, staged);
 }
 
+maps::SnapOptions DispatchService::trip_end_snap(bool vehicle_fix) const {
+  maps::SnapOptions o{config_.snap_max_distance_m};
+  o.skip_ferries = !vehicle_fix;
+  return o;
+}
+
 bool DispatchService::plan_mission(Mission& m, maps::LatLon start, maps::SnapResult& from, maps::SnapResult& to,
                                    std::optional<double> heading) {
-  return planner::plan_nearest_or_main(snapper_, graph_, start, from, m.row.destination, to, {config_.snap_max_distance_m},
+  // The fallback snaps to the main component keep off ferries, as a click does.
+  return planner::plan_nearest_or_main(snapper_, graph_, start, from, m.row.destination, to, trip_end_snap(false),
                                        [&](const maps::SnapResult& a, const maps::SnapResult& b) {
                                          m.destination_local = b.point;
-                                         m.planner = make_planner(m.row, endpoints(a, Role::start, heading),
-                                                                  endpoints(b, Role::goal, std::nullopt));
+                                         auto starts = endpoints(a, Role::start, heading);
+                                         auto goals = planner::at_same_node(graph_, a, b) ? starts : endpoints(b, Role::goal, std::nullopt);
+                                         m.planner = make_planner(m.row, std::move(starts), std::move(goals));
                                          m.model = m.planner.model();
                                          m.planner.replan();
                                          m.route = m.planner.route();
@@ -352,12 +360,12 @@ MissionView DispatchService::create_mission(const MissionRequest& req, double no
   }
   maps::SnapResult from, to;
   try {
-    from = snapper_.snap(*origin, {config_.snap_max_distance_m});
+    from = snapper_.snap(*origin, trip_end_snap(!req.origin));
   } catch (const maps::SnapError& e) {
     throw snap_error(e, "origin");
   }
   try {
-    to = snapper_.snap(req.destination, {config_.snap_max_distance_m});
+    to = snapper_.snap(req.destination, trip_end_snap(false));
   } catch (const maps::SnapError& e) {
     throw snap_error(e, "destination");
   }
@@ -642,8 +650,8 @@ void DispatchService::restore(double now_s) {
     }
     const maps::LatLon start = last ? last->position : row.origin.value_or(row.destination);
     try {
-      auto from = snapper_.snap(start, {config_.snap_max_distance_m});
-      auto to = snapper_.snap(row.destination, {config_.snap_max_distance_m});
+      auto from = snapper_.snap(start, trip_end_snap(last.has_value()));
+      auto to = snapper_.snap(row.destination, trip_end_snap(false));
       auto m = std::make_shared<Mission>();
       m->row = row;
       m->last_position = start;

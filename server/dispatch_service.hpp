@@ -156,6 +156,9 @@ class DispatchService {
   // try from the main component's roads when an end lies on a road cut off from the rest
   // (planner::plan_nearest_or_main); `from` and `to` end at the snaps planned from. Call under the
   // overlay's shared lock. Whether a route was found.
+  // How a trip's end is snapped: a click (a destination, an origin given in the request) never on a
+  // ferry; a vehicle's own position fix may be on one, since it may be riding it.
+  [[nodiscard]] maps::SnapOptions trip_end_snap(bool vehicle_fix) const;
   bool plan_mission(Mission& m, maps::LatLon start, maps::SnapResult& from, maps::SnapResult& to,
                     std::optional<double> heading);
   // Ends a mission in memory; the caller stores the new state (stage_state) first.

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <fstream>
 
+#include "maps/edge_snapper.hpp"
 #include "maps/errors.hpp"
 #include "maps/osm_tags.hpp"
 #include "tests/maps/osm_fixture.hpp"
@@ -104,6 +105,28 @@ TEST(OsmImport, MaxspeedBecomesEdgeSpeed) {
   EXPECT_NEAR(g.speed_mps(edge_between(g, 1, 2)), 30 * 1.609344 / 3.6, 1e-5);
   EXPECT_NEAR(g.speed_mps(edge_between(g, 2, 3)), default_speed_kmh(RoadClass::secondary) / 3.6, 1e-5);
   EXPECT_EQ(g.road_class(edge_between(g, 2, 3)), RoadClass::secondary);
+}
+
+// A ferry's duration is the whole crossing's: each piece of the way runs at the way's length over
+// it. A click beside the berth snaps to the quay road when trip ends skip ferries; a vehicle's own
+// fix may still land on the ferry.
+TEST(OsmImport, FerryDurationSpreadsOverTheWayAndTripEndsSkipFerries) {
+  const auto g = import_fixture({at(1, 0, 0), at(2, 100, 0), at(3, 200, 0), at(4, 300, 0), at(5, 200, 50)},
+                                {{40, {1, 2}, kResidential},
+                                 {41, {2, 3, 4}, {{"route", "ferry"}, {"duration", "0:03"}}},
+                                 {42, {3, 5}, kResidential}});
+  const EdgeId first = edge_between(g, 2, 3), second = edge_between(g, 3, 4);
+  ASSERT_TRUE(first.valid() && second.valid());
+  EXPECT_EQ(g.road_class(first), RoadClass::ferry);
+  EXPECT_NEAR(g.length_m(first) / g.speed_mps(first) + g.length_m(second) / g.speed_mps(second), 180.0, 0.01);
+  const EdgeSnapper snapper(g);
+  const LatLon beside_berth = g.projection().to_lat_lon(g.position(node_by_osm(g, 4)));
+  EXPECT_EQ(g.road_class(snapper.snap(beside_berth).edge), RoadClass::ferry);
+  SnapOptions trip_end;
+  trip_end.skip_ferries = true;
+  const SnapResult quay = snapper.snap(beside_berth, trip_end);
+  EXPECT_NE(g.road_class(quay.edge), RoadClass::ferry);
+  EXPECT_EQ(g.osm_way(quay.edge).v, 42);
 }
 
 TEST(OsmImport, AccessNoAndFootwaysAreExcluded) {

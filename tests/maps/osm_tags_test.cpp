@@ -297,4 +297,59 @@ TEST(WayRules, PhysicalLimitsAreReadNotJudged) {
 }
 
 }  // namespace
+// Ferries as OSRM's car profile reads them: route=ferry|shuttle_train with or without a highway
+// tag, the same access rules, no implied oneway, and the crossing's pace rather than a limit.
+TEST(WayRules, FerriesAndShuttleTrains) {
+  WayTags ferry;
+  ferry.route = "ferry";
+  auto rules = interpret_way(ferry);
+  ASSERT_TRUE(rules.has_value());
+  EXPECT_EQ(rules->road_class, RoadClass::ferry);
+  EXPECT_TRUE(rules->forward && rules->backward);
+  EXPECT_DOUBLE_EQ(rules->forward_speed_kmh, 5.0);
+  EXPECT_DOUBLE_EQ(rules->duration_s, 0.0);
+  ferry.duration = "1:30";
+  ferry.maxspeed = "50";  // a speed limit does not make a boat faster
+  rules = interpret_way(ferry);
+  ASSERT_TRUE(rules.has_value());
+  EXPECT_DOUBLE_EQ(rules->duration_s, 5400.0);
+  EXPECT_DOUBLE_EQ(rules->forward_speed_kmh, 5.0);
+  ferry.oneway = "yes";
+  EXPECT_FALSE(interpret_way(ferry)->backward);
+  ferry.oneway = {};
+  ferry.motor_vehicle = "no";  // a foot ferry
+  EXPECT_FALSE(interpret_way(ferry).has_value());
+
+  WayTags train;
+  train.route = "shuttle_train";
+  rules = interpret_way(train);
+  ASSERT_TRUE(rules.has_value());
+  EXPECT_EQ(rules->road_class, RoadClass::ferry);
+  EXPECT_DOUBLE_EQ(rules->forward_speed_kmh, 10.0);
+  for (const char* other : {"ferry_man", "bus", "road", "hiking"}) {
+    WayTags t;
+    t.route = other;
+    EXPECT_FALSE(interpret_way(t).has_value()) << other;
+  }
+  // A road that is also a ferry route rides the ferry.
+  WayTags both = road("primary");
+  both.route = "ferry";
+  EXPECT_EQ(interpret_way(both)->road_class, RoadClass::ferry);
+  EXPECT_EQ(to_string(RoadClass::ferry), "ferry");
+  EXPECT_FALSE(road_class_from_highway("ferry").has_value());
+}
+
+TEST(DurationParsing, ClockIsoAndMinutes) {
+  EXPECT_DOUBLE_EQ(*parse_duration_s("0:01"), 60.0);
+  EXPECT_DOUBLE_EQ(*parse_duration_s("96:00"), 345600.0);
+  EXPECT_DOUBLE_EQ(*parse_duration_s("1:02:03"), 3723.0);
+  EXPECT_DOUBLE_EQ(*parse_duration_s("45"), 2700.0);
+  EXPECT_DOUBLE_EQ(*parse_duration_s("PT1H30M"), 5400.0);
+  EXPECT_DOUBLE_EQ(*parse_duration_s("P1DT2H"), 93600.0);
+  EXPECT_DOUBLE_EQ(*parse_duration_s(" pt45s "), 45.0);
+  for (const char* bad : {"", "0:00", "abc", "1:2:3:4", "1:", "PT", "P1H", "PT1X", "-1:00", "1h", "1:nan"}) {
+    EXPECT_FALSE(parse_duration_s(bad).has_value()) << bad;
+  }
+}
+
 }  // namespace corridor::maps

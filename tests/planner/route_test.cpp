@@ -175,6 +175,93 @@ TEST(SnapPoints, RoutesBetweenJunctionsCostTheNodeToNodeShortestPath) {
   }
 }
 
+// A click at a junction and a second click there: the vehicle is already where it is sent. Goal
+// points at the node's in-edges would make a start that leaves by an out-edge drive out and back:
+// at a dead end, to the far dead end to turn (the loop `corridor route` gave before at_same_node).
+TEST(SnapPoints, FromANodeToItselfIsAnEmptyRoute) {
+  using maps::testing::at;
+  const std::map<std::string, std::string> road{{"highway", "residential"}};
+  // A street 1-2-3 with a side street 2-4: 1, 3 and 4 are dead ends, 2 a junction.
+  maps::testing::TempDir dir;
+  maps::testing::write_osm(dir.path() / "t.osm", {at(1, 0, 0), at(2, 100, 0), at(3, 200, 0), at(4, 100, 100)},
+                           {{10, {1, 2, 3}, road}, {11, {2, 4}, road}});
+  maps::OsmImportOptions options;
+  options.show_progress = false;
+  const auto g = maps::import_osm(dir.path() / "t.osm", options);
+  const CostOverlay overlay(g);
+  const TravelCost cost(g, overlay, VehicleProfile{});
+  const maps::EdgeSnapper snapper(g);
+  for (NodeId n : g.nodes()) {
+    const maps::SnapResult s = snapper.snap(g.projection().to_lat_lon(g.position(n)));
+    const maps::SnapResult t = s;
+    ASSERT_TRUE(at_same_node(g, s, t));
+    const auto starts = points_from_snap(g, s, PointRole::start);
+    const auto goals = at_same_node(g, s, t) ? starts : points_from_snap(g, t, PointRole::goal);
+    const Route r = OneToOneSearch().run(SearchSpace(cost, starts, goals), false);
+    ASSERT_TRUE(r.found) << "node " << g.osm_node(n).v;
+    EXPECT_EQ(r.length_m, 0.0) << "node " << g.osm_node(n).v;
+    EXPECT_EQ(r.travel_time_s, 0.0) << "node " << g.osm_node(n).v;
+  }
+  // Two different nodes are not one place.
+  const maps::SnapResult at1 = snapper.snap(g.projection().to_lat_lon(g.position(NodeId{0})));
+  const NodeId last{static_cast<std::uint32_t>(g.node_count() - 1)};
+  const maps::SnapResult at_last = snapper.snap(g.projection().to_lat_lon(g.position(last)));
+  EXPECT_FALSE(at_same_node(g, at1, at_last));
+}
+
+// A ferry between two banks, and a long bridge round by the north. The ferry's duration (2 min for
+// its 200 m, two pieces) is its whole crossing time; a profile that does not board ferries takes
+// the bridge; the steps say where the vehicle rides.
+TEST(Ferries, TheDurationIsTheCrossingTimeAndAProfileMayRefuseThem) {
+  using maps::testing::at;
+  const std::map<std::string, std::string> road{{"highway", "residential"}, {"name", "Bank"}};
+  maps::testing::TempDir dir;
+  maps::testing::write_osm(dir.path() / "f.osm",
+                           {at(1, 0, 0), at(2, 100, 0), at(5, 200, 0), at(3, 300, 0), at(4, 400, 0), at(6, 0, 2000),
+                            at(7, 400, 2000)},
+                           {{10, {1, 2}, road},
+                            {11, {3, 4}, road},
+                            {12, {2, 5, 3}, {{"route", "ferry"}, {"duration", "0:02"}, {"name", "Ferry"}}},
+                            {13, {1, 6, 7, 4}, {{"highway", "residential"}, {"name", "Bridge"}}}});
+  maps::OsmImportOptions options;
+  options.show_progress = false;
+  const auto g = maps::import_osm(dir.path() / "f.osm", options);
+  const CostOverlay overlay(g);
+  auto node = [&](long long osm) {
+    for (NodeId n : g.nodes()) {
+      if (g.osm_node(n).v == osm) return n;
+    }
+    ADD_FAILURE() << "no node " << osm;
+    return NodeId{};
+  };
+  auto trip = [&](const VehicleProfile& p) {
+    const TravelCost cost(g, overlay, p);
+    std::vector<EdgePoint> starts, goals;
+    for (EdgeId e : g.out_edges(node(1))) starts.push_back({e, 0.0});
+    for (EdgeId e : g.in_edges(node(4))) goals.push_back({e, g.length_m(e)});
+    return OneToOneSearch().run(SearchSpace(cost, starts, goals), false);
+  };
+  const Route by_ferry = trip(VehicleProfile{});
+  ASSERT_TRUE(by_ferry.found);
+  double on_ferry_s = 0.0;
+  for (std::size_t i = 0; i < by_ferry.edges.size(); ++i) {
+    if (g.road_class(by_ferry.edges[i]) != maps::RoadClass::ferry) continue;
+    on_ferry_s += by_ferry.arrival_s[i] - (i == 0 ? 0.0 : by_ferry.arrival_s[i - 1]);
+  }
+  EXPECT_NEAR(on_ferry_s, 120.0, 0.01);  // both pieces, turn costs aside (the ferry runs straight)
+  const nlohmann::json steps = steps_to_json(g, by_ferry);
+  std::vector<std::string> modes;
+  for (const auto& s : steps) modes.push_back(s["name"].get<std::string>() + ":" + s["mode"].get<std::string>());
+  EXPECT_EQ(modes, (std::vector<std::string>{"Bank:driving", "Ferry:ferry", "Bank:driving", "Bank:driving"}));
+
+  VehicleProfile landlubber;
+  landlubber.ferries = false;
+  const Route by_bridge = trip(landlubber);
+  ASSERT_TRUE(by_bridge.found);
+  for (EdgeId e : by_bridge.edges) EXPECT_NE(g.road_class(e), maps::RoadClass::ferry);
+  EXPECT_GT(by_bridge.travel_time_s, by_ferry.travel_time_s);
+}
+
 // Roads cut off from the main component (maps keeps them): a route onto a one-way spur that
 // leaves the network is planned as clicked; a start where no road leads on, or on an island,
 // gets its second try from the main component's nearest road; and where no component stands out
@@ -199,8 +286,8 @@ class CutOffRoads : public ::testing::Test {
     to = snapper.snap(pb);
     return plan_nearest_or_main(snapper, g, pa, from, pb, to, {}, [&](const maps::SnapResult& s, const maps::SnapResult& t) {
       OneToOneSearch search;
-      return search
-          .run(SearchSpace(cost, points_from_snap(g, s, PointRole::start), points_from_snap(g, t, PointRole::goal)), false)
+      const auto starts = points_from_snap(g, s, PointRole::start);
+      return search.run(SearchSpace(cost, starts, at_same_node(g, s, t) ? starts : points_from_snap(g, t, PointRole::goal)), false)
           .found;
     });
   }

@@ -26,6 +26,8 @@ TEST(VehicleProfile, JsonOverridesABase) {
   EXPECT_EQ(p.uturn_policy, UturnPolicy::anywhere);
   EXPECT_EQ(p.restriction_modes, maps::mode_bit(maps::RestrictionMode::all) | maps::mode_bit(maps::RestrictionMode::hgv));
   EXPECT_EQ(p.speed_factor[static_cast<std::size_t>(maps::RoadClass::residential)], 0.7);
+  EXPECT_TRUE(p.ferries);
+  EXPECT_FALSE(profile_from_json(R"({"ferries": false})").ferries);
   // The JSON written back reads as the same profile.
   EXPECT_EQ(profile_to_json(profile_from_json(profile_to_json(p))), profile_to_json(p));
 }
@@ -51,6 +53,7 @@ TEST(VehicleProfile, BadJsonIsAClearError) {
   EXPECT_NE(error_of(R"({"speed_factor": {"residential": 1.5}})").find("(0, 1]"), std::string::npos);
   EXPECT_NE(error_of(R"({"speed_factor": {"lane": 0.5}})").find("unknown road class"), std::string::npos);
   EXPECT_NE(error_of(R"({"base": "tank"})").find("unknown vehicle profile"), std::string::npos);
+  EXPECT_NE(error_of(R"({"ferries": "sometimes"})").find("'ferries' must be true or false"), std::string::npos);
   EXPECT_THROW((void)load_profile("/nonexistent/profile.json"), ProfileError);
 }
 
