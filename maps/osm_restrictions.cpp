@@ -106,10 +106,24 @@ std::size_t RestrictionResolver::resolve(const OsmRestriction& r, TurnRestrictio
       }
       const auto from = edges_of_way_.find(from_way);
       if (from == edges_of_way_.end()) continue;
+      TurnRestrictions paths;
+      std::size_t found = 0;
       for (EdgeId e : from->second) {
         std::vector<EdgeId> path{e};
-        walk_via(r, to_way, path, out, added);
+        walk_via(r, to_way, path, paths, found);
       }
+      // A from way that reaches the via ways by two edges runs through the junction where they
+      // start: the restriction does not say from which side it binds, and banning both can leave a
+      // street with no way out. OSRM drops it as ambiguous; so do we (it counts as unresolved).
+      std::vector<EdgeId> firsts;
+      for (std::size_t k = 0; k < paths.size(); ++k) firsts.push_back(paths.edges[paths.first[k]]);
+      std::sort(firsts.begin(), firsts.end());
+      if (std::unique(firsts.begin(), firsts.end()) - firsts.begin() > 1) continue;
+      for (std::size_t k = 0; k < paths.size(); ++k) {
+        out.add(std::vector<EdgeId>(paths.edges.begin() + paths.first[k], paths.edges.begin() + paths.first[k + 1]),
+                paths.only[k] != 0, RestrictionMode{paths.mode[k]}, paths.except[k]);
+      }
+      added += found;
     }
   }
   return added;

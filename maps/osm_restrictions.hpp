@@ -37,7 +37,8 @@ bool read_restriction(const osmium::Relation& relation, std::vector<OsmRestricti
 
 // The edge paths an OSM restriction names in the built graph: every from edge arriving at the via
 // node (or at the start of the via ways), through the via ways' edges in any order they connect,
-// onto every to edge. A restriction whose members are not in the graph (cut off by the extract,
+// onto every to edge. A via-way restriction whose from way reaches the via ways by more than one
+// edge (it runs through their first junction) is ambiguous and resolves to nothing, as in OSRM. A restriction whose members are not in the graph (cut off by the extract,
 // one-way the other way, not drivable) resolves to nothing.
 class RestrictionResolver {
  public:

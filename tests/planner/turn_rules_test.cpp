@@ -166,6 +166,48 @@ TEST(TurnRules, ExceptLiftsTheBanForTheVehicleClassesItNames) {
   }
 }
 
+// A via-way restriction whose from way runs through the junction where the via ways start does not
+// say which side it binds (OSRM's "Ambiguous from/to ways"): it is dropped, not applied to both
+// sides. Split the from way at that junction and it binds its one side.
+//
+//   a
+//   |
+//   b --- d --- e     from abc (or ab) via bd, de to ef: no_right_turn
+//   |           |
+//   c           f
+TEST(TurnRules, AViaWayRestrictionFromAWayThroughItsJunctionIsAmbiguous) {
+  using maps::testing::at;
+  auto trip = [](bool split) {
+    maps::testing::TempDir dir;
+    const Tags road{{"highway", "residential"}};
+    std::vector<FixtureWay> ways{{11, {2, 4}, road}, {12, {4, 5}, road}, {13, {5, 6}, road}};
+    if (split) {
+      ways.push_back({10, {1, 2}, road});
+      ways.push_back({14, {2, 3}, road});
+    } else {
+      ways.push_back({10, {1, 2, 3}, road});
+    }
+    maps::testing::write_osm(dir.path() / "amb.osm",
+                             {at(1, 0, 200), at(2, 0, 100), at(3, 0, 0), at(4, 100, 100), at(5, 200, 100), at(6, 200, 0)}, ways,
+                             {restriction({{'w', 10, "from"}, {'w', 11, "via"}, {'w', 12, "via"}, {'w', 13, "to"}},
+                                          {{"restriction", "no_right_turn"}})});
+    maps::OsmImportOptions options;
+    options.show_progress = false;
+    const auto g = maps::import_osm(dir.path() / "amb.osm", options);
+    return drive(g, ambulance_profile(), {{edge(g, 1, 2), 0.0}}, {{edge(g, 5, 6), 50.0}});
+  };
+  const Trip ambiguous = trip(false);
+  ASSERT_TRUE(ambiguous.route.found);
+  // Straight through, as OSRM routes it: 100 + 100 + 100 + 50 m, not down to c and back (+200 m).
+  EXPECT_EQ(ambiguous.ways, (std::vector<long long>{10, 11, 12, 13}));
+  EXPECT_NEAR(ambiguous.route.length_m, 350.0, 2.0);
+  const Trip one_sided = trip(true);
+  ASSERT_TRUE(one_sided.route.found);
+  // From a the ban binds: down to the dead end at c, turn there, and back up.
+  EXPECT_EQ(one_sided.ways, (std::vector<long long>{10, 14, 11, 12, 13}));
+  EXPECT_NEAR(one_sided.route.length_m, 550.0, 2.0);
+}
+
 TEST(TurnRules, TurnsBannedOnRedOnlyStayOpen) {
   for (const char* value : {"no_left_turn_on_red", "no_turn_on_red"}) {
     const auto g = plus_map({restriction({{'w', kSouth, "from"}, {'n', 2, "via"}, {'w', kWest, "to"}}, {{"restriction", value}})});
