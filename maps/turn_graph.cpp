@@ -129,12 +129,7 @@ TurnGraph::TurnGraph(const RoadGraphData& d) : edge_count_(d.edge_head.size()) {
       if (arc == nullptr) {
         throw MapError("inconsistent road graph: turn restriction " + std::to_string(k) + " names edges that do not meet");
       }
-      // A via-way only_ binds once the vehicle has turned from the from edge onto the via ways:
-      // leaving the from edge another way is not forbidden, as OSRM reads it (its scenarios
-      // "Multi-Way overlapping single-way" and "Overlapping multiple via restrictions"). A via-node
-      // only_ is the one way out of its from edge.
-      const bool binds_here = i > 1 || path.size() == 2;
-      if (only && binds_here) only_allowed[{cur, modes, except}].push_back(next);
+      if (only) only_allowed[{cur, modes, except}].push_back(next);
       if (i + 1 == path.size()) {
         if (!only) add_ban(*arc, modes, except);
         break;

@@ -47,7 +47,7 @@ std::string_view to_string(VehicleClass c);
 // Flat arrays (the cache stores them as they are). Restriction r forbids driving
 // edges[first[r] .. first[r+1]) in that order (from, via edges..., to): a via-node restriction has
 // two edges, a via-way one more. An `only_*` restriction instead forbids every other way out of the
-// from edge (via node) or, once the vehicle is on its via edges, every way off them (via way).
+// from edge and, along its via edges, every way off them.
 struct TurnRestrictions {
   std::vector<std::uint32_t> first{0};
   std::vector<EdgeId> edges;

@@ -30,8 +30,7 @@ std::string violation(const maps::RoadGraph& g, const VehicleProfile& p, const s
       std::size_t i = 1;
       while (i < path.size() && j + i < driven.size() && driven[j + i] == path[i]) ++i;
       const bool whole = i == path.size();
-      // A via-way only_ binds from the first via edge on; a via-node one at its from edge.
-      const bool left_an_only = r.only[k] != 0 && i < path.size() && j + i < driven.size() && (i > 1 || path.size() == 2);
+      const bool left_an_only = r.only[k] != 0 && i < path.size() && j + i < driven.size();
       if ((r.only[k] == 0 && whole) || left_an_only) {
         return "restriction " + std::to_string(k) + (r.only[k] != 0 ? " (only_)" : " (no_)") + " at route edge " +
                std::to_string(j);

