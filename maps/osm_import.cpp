@@ -227,7 +227,10 @@ RoadGraph import_osm(const std::filesystem::path& path, const OsmImportOptions& 
         length += distance_m(projection.to_local({c.locations[k - 1].lat(), c.locations[k - 1].lon()}),
                              projection.to_local({c.locations[k].lat(), c.locations[k].lon()}));
       }
-      if (length > 0) way.rules.forward_speed_kmh = way.rules.backward_speed_kmh = length / way.rules.duration_s / kKmhToMps;
+      // A duration that makes the crossing faster than any road, or that a float speed cannot hold,
+      // is a tagging slip: the class's pace is kept.
+      const double kmh = length / way.rules.duration_s / kKmhToMps;
+      if (length > 0 && kmh >= 1e-4 && kmh <= 200.0) way.rules.forward_speed_kmh = way.rules.backward_speed_kmh = kmh;
     }
     std::uint32_t i = way.first_ref;
     while (i < end) {

@@ -250,7 +250,7 @@ std::optional<double> parse_duration_s(std::string_view raw) {
         continue;
       }
       double n = 0.0;
-      const auto [ptr, ec] = std::from_chars(v.data() + i, v.data() + v.size(), n);
+      const auto [ptr, ec] = std::from_chars(v.data() + i, v.data() + v.size(), n, std::chars_format::fixed);
       if (ec != std::errc{} || ptr == v.data() + v.size() || !std::isfinite(n) || n < 0) return std::nullopt;
       const char unit = *ptr;
       i = static_cast<std::size_t>(ptr - v.data()) + 1;
@@ -270,7 +270,7 @@ std::optional<double> parse_duration_s(std::string_view raw) {
     while (true) {
       if (count == 3) return std::nullopt;
       double n = 0.0;
-      const auto [ptr, ec] = std::from_chars(rest.data(), rest.data() + rest.size(), n);
+      const auto [ptr, ec] = std::from_chars(rest.data(), rest.data() + rest.size(), n, std::chars_format::fixed);
       if (ec != std::errc{} || !std::isfinite(n) || n < 0) return std::nullopt;
       parts[count++] = n;
       rest.remove_prefix(static_cast<std::size_t>(ptr - rest.data()));
@@ -280,7 +280,8 @@ std::optional<double> parse_duration_s(std::string_view raw) {
     }
     total = count == 1 ? parts[0] * 60.0 : parts[0] * 3600.0 + parts[1] * 60.0 + parts[2];
   }
-  if (!(total > 0.0) || !std::isfinite(total)) return std::nullopt;
+  constexpr double kYearS = 365.0 * 86400.0;
+  if (!(total > 0.0) || !(total <= kYearS)) return std::nullopt;
   return total;
 }
 

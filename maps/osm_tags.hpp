@@ -93,7 +93,8 @@ struct WayRules {
 std::optional<WayRules> interpret_way(const WayTags& tags);
 
 // A duration in seconds: "hh:mm", "hh:mm:ss", a number of minutes, or ISO 8601 ("PT1H30M",
-// "P1DT2H"). nullopt for anything else, or for zero.
+// "P1DT2H"). Plain decimals only (no exponents). nullopt for anything else, for zero, and for more
+// than a year.
 std::optional<double> parse_duration_s(std::string_view value);
 
 // A length in metres: "3.5", "3.5 m", "12 ft", "11'6\"". nullopt for "default", "none",

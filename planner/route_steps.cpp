@@ -89,6 +89,7 @@ std::vector<RouteStep> route_steps(const maps::RoadGraph& g, const Route& route,
       const EdgeId in = route.edges[i - 1], out = route.edges[i];
       const bool entering = g.on_roundabout(out) && !g.on_roundabout(in);
       const bool inside_or_leaving = g.on_roundabout(in);
+      const bool boards_or_leaves = (g.road_class(in) == maps::RoadClass::ferry) != (g.road_class(out) == maps::RoadClass::ferry);
       if (entering) {
         // One step for the whole roundabout, named after the road it leaves by.
         std::size_t last = i;
@@ -103,11 +104,11 @@ std::vector<RouteStep> route_steps(const maps::RoadGraph& g, const Route& route,
         s.modifier = modifier_for_turn(s.turn_deg);
         s.location = g.position(g.tail(out));
         steps.push_back(s);
-      } else if (!inside_or_leaving) {
+      } else if (!inside_or_leaving || boards_or_leaves) {
+        // (Straight off a roundabout onto a ferry: boarding is a step of its own.)
         const double turn = turn_between(g, in, out);
         const bool renamed = g.name(in) != g.name(out) || g.ref(in) != g.ref(out);
         const bool sharp = std::abs(turn) >= options.continue_turn_deg;
-        const bool boards_or_leaves = (g.road_class(in) == maps::RoadClass::ferry) != (g.road_class(out) == maps::RoadClass::ferry);
         if (renamed || sharp || boards_or_leaves) {
           RouteStep s;
           s.name = g.name(out);

@@ -208,6 +208,22 @@ TEST(TurnRules, AViaWayRestrictionFromAWayThroughItsJunctionIsAmbiguous) {
   EXPECT_NEAR(one_sided.route.length_m, 550.0, 2.0);
 }
 
+// Two restrictions forbid the same turn with different except lists: each binds whom its own list
+// does not name. except=motorcar and except=hgv together bind both vehicles; two lists that both
+// name psv lift the ban for both.
+TEST(TurnRules, TwoExceptedBansOnOneTurnEachBindWhomTheirListLeavesOut) {
+  auto both = [](const char* first, const char* second) {
+    return plus_map({restriction({{'w', kSouth, "from"}, {'n', 2, "via"}, {'w', kWest, "to"}}, {{"restriction", "no_left_turn"}, {"except", first}}),
+                     restriction({{'w', kSouth, "from"}, {'n', 2, "via"}, {'w', kWest, "to"}}, {{"restriction", "no_left_turn"}, {"except", second}})});
+  };
+  const auto split = both("motorcar", "hgv");
+  EXPECT_NE(south_to_west(split).ways, kLeftAtTwo);
+  EXPECT_NE(south_to_west(split, fire_engine_profile()).ways, kLeftAtTwo);
+  const auto shared = both("motorcar;psv", "hgv;psv");
+  EXPECT_EQ(south_to_west(shared).ways, kLeftAtTwo);
+  EXPECT_EQ(south_to_west(shared, fire_engine_profile()).ways, kLeftAtTwo);
+}
+
 TEST(TurnRules, TurnsBannedOnRedOnlyStayOpen) {
   for (const char* value : {"no_left_turn_on_red", "no_turn_on_red"}) {
     const auto g = plus_map({restriction({{'w', kSouth, "from"}, {'n', 2, "via"}, {'w', kWest, "to"}}, {{"restriction", value}})});

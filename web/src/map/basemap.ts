@@ -25,6 +25,7 @@ const CLASS_STYLE: Record<string, ClassStyle> = {
   unclassified: { color: '#a9a9a9', weight: 1.8 },
   living_street: { color: '#bdbdbd', weight: 1.5 },
   service: { color: '#c4c4c4', weight: 1.2 },
+  ferry: { color: '#7fa8d8', weight: 1.5 },
 };
 const DEFAULT_STYLE: ClassStyle = { color: '#bdbdbd', weight: 1.2 };
 
