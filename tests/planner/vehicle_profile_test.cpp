@@ -32,15 +32,17 @@ TEST(VehicleProfile, JsonOverridesABase) {
   EXPECT_EQ(profile_to_json(profile_from_json(profile_to_json(p))), profile_to_json(p));
 }
 
+// The message a profile JSON is rejected with, or "accepted".
+std::string error_of(const char* json) {
+  try {
+    (void)profile_from_json(json);
+  } catch (const ProfileError& e) {
+    return std::string(e.what());
+  }
+  return std::string("accepted");
+}
+
 TEST(VehicleProfile, BadJsonIsAClearError) {
-  auto error_of = [](const char* json) {
-    try {
-      (void)profile_from_json(json);
-    } catch (const ProfileError& e) {
-      return std::string(e.what());
-    }
-    return std::string("accepted");
-  };
   EXPECT_NE(error_of("{").find("not valid JSON"), std::string::npos);
   EXPECT_NE(error_of(R"({"height_m": 1e4444})").find("not valid JSON"), std::string::npos);  // overflows a double
   EXPECT_NE(error_of("[]").find("object"), std::string::npos);
@@ -65,14 +67,6 @@ TEST(VehicleProfile, ExceptClassesFromJson) {
   EXPECT_EQ(profile_from_json(R"({"except_classes": []})").except_classes, 0);
   // The older key: false lifts nothing (true keeps the base's classes, which name emergency and psv).
   EXPECT_EQ(profile_from_json(R"({"emergency_exceptions": false})").except_classes, 0);
-  auto error_of = [](const char* json) {
-    try {
-      (void)profile_from_json(json);
-    } catch (const ProfileError& e) {
-      return std::string(e.what());
-    }
-    return std::string("accepted");
-  };
   EXPECT_NE(error_of(R"({"except_classes": ["bus"]})").find("unknown vehicle class \"bus\""), std::string::npos);
   EXPECT_NE(error_of(R"({"except_classes": "hgv"})").find("array"), std::string::npos);
   EXPECT_NE(error_of(R"({"except_classes": [], "emergency_exceptions": true})").find("not both"), std::string::npos);
