@@ -133,7 +133,7 @@ SnapResult EdgeSnapper::snap_local(Point2 p, const SnapOptions& options) const {
     const auto wanted = [&](const std::pair<BgSegment, std::uint32_t>& v) {
       const EdgeId e = index_->pieces[v.second].edge;
       return (!options.main_component_only || graph_.in_main_component(e)) &&
-             (!options.skip_ferries || graph_.road_class(e) != RoadClass::ferry);
+             (!options.skip_ferries || !graph_.is_ferry(e));
     };
     index_->tree.query(bgi::nearest(BgPoint{p.x_m, p.y_m}, 1) && bgi::satisfies(wanted), std::back_inserter(found));
   } else {

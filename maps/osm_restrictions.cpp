@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "maps/osm_tags.hpp"
 #include "maps/turn_graph.hpp"
 
 namespace corridor::maps {

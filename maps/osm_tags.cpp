@@ -142,20 +142,27 @@ bool access_item_forbids(std::string_view v) {
                        "bicycle", "horse", "restricted", "military"});
 }
 
-// A value or a ';'-separated list of them: forbids when every listed item does.
-bool access_forbids(std::string_view v) {
-  bool any = false;
+// Calls f on each non-empty, trimmed item of a ';'-separated value until f returns false.
+template <class F>
+void for_each_item(std::string_view v, F&& f) {
   while (!v.empty()) {
     const auto semi = v.find(';');
     const std::string_view item = trim(v.substr(0, semi));
-    if (!item.empty()) {
-      if (!access_item_forbids(item)) return false;
-      any = true;
-    }
-    if (semi == std::string_view::npos) break;
+    if (!item.empty() && !f(item)) return;
+    if (semi == std::string_view::npos) return;
     v.remove_prefix(semi + 1);
   }
-  return any;
+}
+
+// A value or a ';'-separated list of them: forbids when every listed item does.
+bool access_forbids(std::string_view v) {
+  bool any = false, all = true;
+  for_each_item(v, [&](std::string_view item) {
+    any = true;
+    all = access_item_forbids(item);
+    return all;
+  });
+  return any && all;
 }
 
 // The most specific access tag present decides: true when it forbids.
@@ -167,6 +174,16 @@ bool most_specific_forbids(std::initializer_list<std::string_view> most_specific
 }
 
 }  // namespace
+
+std::uint8_t except_classes(std::string_view list) {
+  std::uint8_t mask = 0;
+  for_each_item(list, [&](std::string_view item) {
+    VehicleClass c{};
+    if (vehicle_class_from_name(item, c)) mask |= class_bit(c);
+    return true;
+  });
+  return mask;
+}
 
 std::optional<double> parse_weight_t(std::string_view raw) {
   const std::string v = lower(trim(raw));

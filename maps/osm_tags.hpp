@@ -6,6 +6,7 @@
 #include <string_view>
 
 #include "maps/road_class.hpp"
+#include "maps/turn_restriction.hpp"
 
 namespace corridor::maps {
 
@@ -119,6 +120,10 @@ bool node_blocks_emergency(const NodeTags& tags);
 // country values ("DE:urban", "FR:rural", "CH:motorway", "GB:nsl_single", "DE:zone30", ...).
 // nullopt for values that carry no speed ("signals", "variable") or cannot be parsed.
 std::optional<double> parse_maxspeed_kmh(std::string_view value);
+
+// The vehicle classes an `except=*` list names ("psv;emergency"), as VehicleClass bits. Values that
+// are no VehicleClass (bicycle, bus, ...) name no class a profile can belong to and are ignored.
+std::uint8_t except_classes(std::string_view list);
 
 // Free-flow speed assumed where maxspeed is missing (documented in README "Speed defaults").
 double default_speed_kmh(RoadClass c);

@@ -101,6 +101,8 @@ class RoadGraph {
   [[nodiscard]] double speed_mps(EdgeId e) const { return data_.edge_speed_mps[e.index()]; }
   [[nodiscard]] OsmWayId osm_way(EdgeId e) const { return data_.edge_osm_way[e.index()]; }
   [[nodiscard]] RoadClass road_class(EdgeId e) const { return data_.edge_class[e.index()]; }
+  // A ferry or shuttle train: the vehicle rides it (trips do not start or end on one).
+  [[nodiscard]] bool is_ferry(EdgeId e) const { return road_class(e) == RoadClass::ferry; }
   [[nodiscard]] EdgeId twin(EdgeId e) const { return data_.edge_twin[e.index()]; }
   // The place `offset_m` along e, measured along its twin (which must exist): the same share of the
   // way from the other end, since the two directions of a road may differ in length (a SUMO net's

@@ -37,9 +37,6 @@ enum class VehicleClass : std::uint8_t {
 inline constexpr int kVehicleClassCount = 6;
 inline constexpr std::uint8_t class_bit(VehicleClass c) { return static_cast<std::uint8_t>(1u << static_cast<unsigned>(c)); }
 
-// The classes a ';'-list names ("psv;emergency"); values outside VehicleClass (bicycle, bus, ...)
-// name no class a profile can belong to and are ignored.
-std::uint8_t except_classes(std::string_view list);
 // The class a name stands for ("motorcar"), or false when it is not one.
 bool vehicle_class_from_name(std::string_view name, VehicleClass& out);
 std::string_view to_string(VehicleClass c);

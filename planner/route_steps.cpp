@@ -81,7 +81,7 @@ std::vector<RouteStep> route_steps(const maps::RoadGraph& g, const Route& route,
   depart.name = g.name(route.edges[0]);
   depart.ref = g.ref(route.edges[0]);
   depart.maneuver = ManeuverType::depart;
-  depart.ferry = g.road_class(route.edges[0]) == maps::RoadClass::ferry;
+  depart.ferry = g.is_ferry(route.edges[0]);
   depart.location = g.point_along(route.edges[0], route.start.offset_m);
   steps.push_back(depart);
   for (std::size_t i = 0; i < n; ++i) {
@@ -89,7 +89,7 @@ std::vector<RouteStep> route_steps(const maps::RoadGraph& g, const Route& route,
       const EdgeId in = route.edges[i - 1], out = route.edges[i];
       const bool entering = g.on_roundabout(out) && !g.on_roundabout(in);
       const bool inside_or_leaving = g.on_roundabout(in);
-      const bool boards_or_leaves = (g.road_class(in) == maps::RoadClass::ferry) != (g.road_class(out) == maps::RoadClass::ferry);
+      const bool boards_or_leaves = g.is_ferry(in) != g.is_ferry(out);
       if (entering) {
         // One step for the whole roundabout, named after the road it leaves by.
         std::size_t last = i;
@@ -119,7 +119,7 @@ std::vector<RouteStep> route_steps(const maps::RoadGraph& g, const Route& route,
                        : s.modifier == TurnModifier::straight ? ManeuverType::new_name
                                                                : ManeuverType::turn;
           s.location = g.position(g.tail(out));
-          s.ferry = g.road_class(out) == maps::RoadClass::ferry;
+          s.ferry = g.is_ferry(out);
           steps.push_back(s);
         }
       }
@@ -131,7 +131,7 @@ std::vector<RouteStep> route_steps(const maps::RoadGraph& g, const Route& route,
   arrive.name = g.name(route.edges.back());
   arrive.ref = g.ref(route.edges.back());
   arrive.maneuver = ManeuverType::arrive;
-  arrive.ferry = g.road_class(route.edges.back()) == maps::RoadClass::ferry;
+  arrive.ferry = g.is_ferry(route.edges.back());
   arrive.location = g.point_along(route.edges.back(), route.goal.offset_m);
   steps.push_back(arrive);
   return steps;

@@ -36,7 +36,7 @@ TravelCost::TravelCost(const maps::RoadGraph& graph, const CostOverlay& overlay,
   }
   if (!profile_.ferries) {
     for (EdgeId e : graph.edges()) {
-      if (graph.road_class(e) != maps::RoadClass::ferry) continue;
+      if (!graph.is_ferry(e)) continue;
       if (blocked_.empty()) blocked_.assign(graph.edge_count(), 0);
       blocked_[e.index()] = 1;
     }
