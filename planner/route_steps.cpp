@@ -22,6 +22,28 @@ int roundabout_exit(const maps::RoadGraph& g, const std::vector<EdgeId>& edges, 
   return std::max(exits, 1);
 }
 
+// Folds a first step shorter than min_m into the second (which becomes the depart, from the trip's
+// start), and a last one into the one before it. A roundabout step is never dropped: its exit
+// count is the instruction. At least one step always stays.
+void trim_end_steps(std::vector<RouteStep>& steps, double min_m) {
+  if (steps.size() >= 2 && steps.front().distance_m < min_m && steps[1].maneuver != ManeuverType::roundabout) {
+    RouteStep& next = steps[1];
+    next.distance_m += steps.front().distance_m;
+    next.duration_s += steps.front().duration_s;
+    next.location = steps.front().location;
+    next.maneuver = ManeuverType::depart;
+    next.modifier = TurnModifier::none;
+    next.turn_deg = 0;
+    steps.erase(steps.begin());
+  }
+  if (steps.size() >= 2 && steps.back().distance_m < min_m && steps.back().maneuver != ManeuverType::roundabout) {
+    RouteStep& previous = steps[steps.size() - 2];
+    previous.distance_m += steps.back().distance_m;
+    previous.duration_s += steps.back().duration_s;
+    steps.pop_back();
+  }
+}
+
 }  // namespace
 
 const char* to_string(ManeuverType t) {
@@ -127,11 +149,12 @@ std::vector<RouteStep> route_steps(const maps::RoadGraph& g, const Route& route,
     steps.back().distance_m += piece_m(i);
     steps.back().duration_s += piece_s(i);
   }
+  trim_end_steps(steps, options.min_end_step_m);
   RouteStep arrive;
-  arrive.name = g.name(route.edges.back());
-  arrive.ref = g.ref(route.edges.back());
+  arrive.name = steps.back().name;
+  arrive.ref = steps.back().ref;
   arrive.maneuver = ManeuverType::arrive;
-  arrive.ferry = g.is_ferry(route.edges.back());
+  arrive.ferry = steps.back().ferry;
   arrive.location = g.point_along(route.edges.back(), route.goal.offset_m);
   steps.push_back(arrive);
   return steps;

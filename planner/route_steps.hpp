@@ -33,13 +33,18 @@ struct RouteStep {
 struct StepOptions {
   // A turn at least this sharp starts a new step even when the street's name does not change.
   double continue_turn_deg = 45.0;
+  // A first or last step shorter than this is folded into its neighbour: a trip that starts (or
+  // ends) within it of a junction starts (or ends) at the junction, and "drive 0.3 m on West Street,
+  // then turn left" is noise from the click or the fix, not an instruction. Smaller than any snap
+  // or GPS error, so it never hides a street the vehicle really drives.
+  double min_end_step_m = 1.0;
 };
 
 // The modifier for a signed turn angle (right positive, degrees in (-180, 180]).
 TurnModifier modifier_for_turn(double turn_deg);
 
 // Depart, one step per street (or per sharp turn on one street, or per boarding or leaving a
-// ferry), arrive. A roundabout is one step,
+// ferry), arrive; a first or last step shorter than min_end_step_m is folded into its neighbour. A roundabout is one step,
 // "roundabout" with the exit to take, named after the road it leaves by, as OSRM gives it. Empty for
 // a route not found.
 std::vector<RouteStep> route_steps(const maps::RoadGraph& graph, const Route& route, const StepOptions& options = {});

@@ -403,5 +403,29 @@ TEST(TurnRules, RoundaboutIsOneStepWithItsExitNumber) {
   }
 }
 
+
+// A trip that starts or ends within a metre of a junction starts or ends at it: no step of 0.3 m on
+// the street it leaves (or reaches) at once. Two metres is a real step and stays.
+TEST(TurnRules, AStepShorterThanAMetreAtEitherEndIsFoldedIntoItsNeighbour) {
+  const auto g = plus_map({});
+  const EdgeId west = edge(g, 1, 2), north = edge(g, 2, 5);
+  auto names = [&](const EdgePoint& from, const EdgePoint& to) {
+    const Trip t = drive(g, ambulance_profile(), {from}, {to});
+    EXPECT_TRUE(t.route.found);
+    std::vector<std::string> out;
+    double total_m = 0;
+    for (const RouteStep& s : route_steps(g, t.route)) {
+      out.push_back(std::string(to_string(s.maneuver)) + ":" + s.name);
+      total_m += s.distance_m;
+    }
+    EXPECT_NEAR(total_m, g.length_m(west) - from.offset_m + to.offset_m, 1e-6);  // no metre lost
+    return out;
+  };
+  using V = std::vector<std::string>;
+  EXPECT_EQ(names({west, g.length_m(west) - 0.3}, {north, 50.0}), (V{"depart:North", "arrive:North"}));
+  EXPECT_EQ(names({west, 50.0}, {north, 0.3}), (V{"depart:West", "arrive:West"}));
+  EXPECT_EQ(names({west, g.length_m(west) - 2.0}, {north, 2.0}), (V{"depart:West", "turn:North", "arrive:North"}));
+}
+
 }  // namespace
 }  // namespace corridor::planner
