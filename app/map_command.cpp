@@ -16,6 +16,8 @@ namespace {
 nlohmann::json describe(const maps::RoadGraph& g) {
   std::size_t signals = 0;
   for (NodeId v : g.nodes()) signals += g.signalized(v) ? 1 : 0;
+  std::size_t stops = 0;  // nodes with a gate or toll booth the vehicle stops at
+  for (NodeId v : g.nodes()) stops += g.stop_at(v) ? 1 : 0;
   const maps::LatLon lo = g.projection().to_lat_lon(g.min_corner());
   const maps::LatLon hi = g.projection().to_lat_lon(g.max_corner());
   return {{"nodes", g.node_count()},
@@ -26,6 +28,7 @@ nlohmann::json describe(const maps::RoadGraph& g) {
           {"turns", g.turns().arc_count()},
           {"restriction_copies", g.turns().copy_count()},
           {"limited_edges", g.edge_limits().size()},
+          {"stop_nodes", stops},
           {"main_component_nodes", g.main_component_nodes()},
           {"traffic_keeps", g.left_hand_traffic() ? "left" : "right"}};
 }
@@ -56,6 +59,7 @@ void run_import(const ImportOptions& o) {
   j["osm_ways_kept"] = report.osm_ways_kept;
   j["osm_signal_nodes"] = report.osm_signal_nodes;
   j["osm_barrier_nodes"] = report.osm_barrier_nodes;
+  j["osm_stop_nodes"] = report.osm_stop_nodes;
   j["osm_restrictions_applied"] = report.osm_restrictions_applied;
   j["osm_restrictions_unresolved"] = report.osm_restrictions_unresolved;
   j["graph_nodes_before_scc"] = report.graph.input_nodes;

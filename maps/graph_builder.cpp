@@ -118,7 +118,9 @@ RoadGraph build_road_graph(const GraphBuildInput& in, GraphBuildReport* report, 
     d.node_y_m.push_back(in.node_pos[u].y_m);
     d.node_osm_id.push_back(in.node_osm[u]);
     d.node_signalized.push_back(in.node_signalized[u]);
+    if (!in.node_stop.empty()) d.node_stop.push_back(in.node_stop[u]);
   }
+  if (std::find(d.node_stop.begin(), d.node_stop.end(), std::uint8_t{1}) == d.node_stop.end()) d.node_stop.clear();
 
   // Every edge, ordered by new tail (stable, so twins stay deterministic).
   std::vector<std::uint32_t> order;

@@ -34,6 +34,9 @@ struct GraphBuildInput {
   std::vector<Point2> node_pos;
   std::vector<OsmNodeId> node_osm;
   std::vector<std::uint8_t> node_signalized;
+  // 1 where a barrier stands that the vehicle passes but stops at (a gate, a toll booth). Empty, or
+  // one per node.
+  std::vector<std::uint8_t> node_stop;
   std::vector<RoadSegment> segments;
   std::vector<Point2> points;
   StringTable strings;  // street names and refs of the segments

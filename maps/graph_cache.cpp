@@ -116,6 +116,7 @@ void visit_arrays(Visitor&& v, auto& d) {
   v(d.landmarks.to_ticks);
   v(d.edge_limits);
   v(d.roundabout_edges);
+  v(d.node_stop);
   v(d.restrictions.first);
   v(d.restrictions.edges);
   v(d.restrictions.only);

@@ -51,6 +51,7 @@ class RoadCollector : public osmium::handler::Handler {
     nt.motorcar = tag(t, "motorcar");
     nt.emergency = tag(t, "emergency");
     if (node_blocks_emergency(nt)) barriers.push_back(node.id());
+    if (node_stops_vehicle(nt)) stops.push_back(node.id());
     // A height restrictor stops what is taller than its maxheight: a limit on the roads through it.
     if (nt.barrier == "height_restrictor" || !tag(t, "maxheight").empty()) {
       if (const auto h = parse_length_m(nt.maxheight)) height_limits.emplace_back(node.id(), *h);
@@ -116,6 +117,7 @@ class RoadCollector : public osmium::handler::Handler {
   std::vector<osmium::Location> locations;
   std::vector<osmium::object_id_type> signals;
   std::vector<osmium::object_id_type> barriers;  // nodes an emergency vehicle cannot pass
+  std::vector<osmium::object_id_type> stops;     // barriers it passes but stops at (gates, toll booths)
   std::vector<std::pair<osmium::object_id_type, double>> height_limits;  // node, maxheight (m)
   StringInterner strings;
 };
@@ -154,6 +156,7 @@ RoadGraph import_osm(const std::filesystem::path& path, const OsmImportOptions& 
   RoadCollector c = read_file(path, options);
   std::sort(c.signals.begin(), c.signals.end());
   std::sort(c.barriers.begin(), c.barriers.end());
+  std::sort(c.stops.begin(), c.stops.end());
   std::sort(c.height_limits.begin(), c.height_limits.end());
   auto node_height_limit = [&](osmium::object_id_type id) {
     const auto it = std::lower_bound(c.height_limits.begin(), c.height_limits.end(), std::make_pair(id, 0.0));
@@ -178,6 +181,7 @@ RoadGraph import_osm(const std::filesystem::path& path, const OsmImportOptions& 
   auto is_barrier = [&](osmium::object_id_type id) {
     return std::binary_search(c.barriers.begin(), c.barriers.end(), id);
   };
+  auto is_stop = [&](osmium::object_id_type id) { return std::binary_search(c.stops.begin(), c.stops.end(), id); };
 
   if (sorted_refs.empty()) throw MapLoadError("no drivable road in '" + path.string() + "'");
 
@@ -199,6 +203,7 @@ RoadGraph import_osm(const std::filesystem::path& path, const OsmImportOptions& 
     in.node_pos.push_back(projection.to_local({c.locations[ref_i].lat(), c.locations[ref_i].lon()}));
     in.node_osm.push_back(OsmNodeId{id});
     in.node_signalized.push_back(is_signal(id) ? 1 : 0);
+    in.node_stop.push_back(is_stop(id) ? 1 : 0);
     return static_cast<std::uint32_t>(in.node_pos.size() - 1);
   };
   // A barrier the vehicle cannot pass becomes a separate dead end for every road that reaches it:
@@ -249,7 +254,8 @@ RoadGraph import_osm(const std::filesystem::path& path, const OsmImportOptions& 
           const Point2 p = projection.to_local({c.locations[k].lat(), c.locations[k].lon()});
           along += distance_m(in.points.back(), p);
           segment_height = tighter(segment_height, node_height_limit(c.refs[k]));
-          const bool is_junction = k + 1 == run_end || use_count(c.refs[k]) >= 2 || is_barrier(c.refs[k]);
+          // A gate the vehicle stops at is a node of its own too, where its delay is charged.
+          const bool is_junction = k + 1 == run_end || use_count(c.refs[k]) >= 2 || is_barrier(c.refs[k]) || is_stop(c.refs[k]);
           if (!is_junction) {
             in.points.push_back(p);
             if (is_signal(c.refs[k])) interior_signals.emplace_back(k, along);
@@ -318,6 +324,7 @@ RoadGraph import_osm(const std::filesystem::path& path, const OsmImportOptions& 
   local.osm_ways_kept = c.ways.size();
   local.osm_signal_nodes = c.signals.size();
   local.osm_barrier_nodes = c.barriers.size();
+  local.osm_stop_nodes = c.stops.size();
   if (report != nullptr) *report = local;
   return graph;
 }

@@ -24,6 +24,7 @@ struct OsmImportReport {
   std::size_t osm_ways_kept = 0;
   std::size_t osm_signal_nodes = 0;
   std::size_t osm_barrier_nodes = 0;  // nodes an emergency vehicle cannot pass (split into dead ends)
+  std::size_t osm_stop_nodes = 0;     // barriers it passes but stops at (gates, toll booths), charged by the profile
   std::size_t osm_restrictions_applied = 0;     // restriction keys resolved onto graph edges
   std::size_t osm_restrictions_unresolved = 0;  // malformed, or members outside the graph
   GraphBuildReport graph;

@@ -214,6 +214,13 @@ bool node_blocks_emergency(const NodeTags& t) {
                                 "border_control", "cattle_grid", "entrance", "sally_port", "arch", "bump_gate"});
 }
 
+bool node_stops_vehicle(const NodeTags& t) {
+  if (node_blocks_emergency(t)) return false;
+  if (t.barrier == "bollard") return is_one_of(t.bollard, {"rising", "removable", "retractable", "foldable"});
+  return is_one_of(t.barrier,
+                   {"gate", "lift_gate", "swing_gate", "sliding_gate", "bump_gate", "sally_port", "toll_booth", "border_control"});
+}
+
 std::optional<double> parse_maxspeed_kmh(std::string_view raw) {
   std::string_view v = trim(raw);
   if (const auto semi = v.find(';'); semi != std::string_view::npos) v = trim(v.substr(0, semi));

@@ -57,6 +57,7 @@ void validate(const RoadGraphData& d) {
                 l.max_height_m >= 0 && l.max_width_m >= 0 && l.max_weight_t >= 0,
             "edge limit is not a finite non-negative number");
   }
+  require(d.node_stop.empty() || d.node_stop.size() == n, "barrier stops do not cover the nodes");
   for (std::size_t i = 0; i < d.roundabout_edges.size(); ++i) {
     require(d.roundabout_edges[i].index() < m && (i == 0 || d.roundabout_edges[i - 1] < d.roundabout_edges[i]),
             "roundabout edges unsorted or out of range");

@@ -67,6 +67,11 @@ struct RoadGraphData {
   std::vector<EdgeLimit> edge_limits;
   // Edges on a roundabout (junction=roundabout|circular), sorted; for "take exit N" steps.
   std::vector<EdgeId> roundabout_edges;
+  // Per node, 1 where a barrier stands that the vehicle passes but stops at (a gate, a toll booth;
+  // maps::node_stops_vehicle). The importer makes each such node a graph node of its own, so the
+  // delay is charged exactly as a signal's is: once for each route through the node. Empty when the
+  // map has none.
+  std::vector<std::uint8_t> node_stop;
 
   // Turn restrictions on the edges (maps/turn_restriction.hpp); empty where the source has none.
   TurnRestrictions restrictions;
@@ -148,6 +153,9 @@ class RoadGraph {
   }
 
   [[nodiscard]] std::span<const EdgeLimit> edge_limits() const { return data_.edge_limits; }
+  // Whether a barrier the vehicle stops at (a gate, a toll booth) stands on node v.
+  [[nodiscard]] bool has_stops() const { return !data_.node_stop.empty(); }
+  [[nodiscard]] bool stop_at(NodeId v) const { return has_stops() && data_.node_stop[v.index()] != 0; }
   [[nodiscard]] bool on_roundabout(EdgeId e) const {
     return std::binary_search(data_.roundabout_edges.begin(), data_.roundabout_edges.end(), e);
   }

@@ -46,7 +46,12 @@ class TravelCost {
     return free_flow * std::max(overlay_->edge(e).congestion_factor, 1.0);
   }
   [[nodiscard]] double edge_time_s(EdgeId e) const { return add_cost(running_time_s(e), overlay_->edge(e).queue_delay_s); }
-  [[nodiscard]] double node_delay_s(NodeId v) const { return overlay_->node_delay_s(v); }
+  // Crossing node v: its delay on the overlay (a signal's expected wait), plus the profile's
+  // barrier_delay_s where a gate or toll booth stands on it.
+  [[nodiscard]] double node_delay_s(NodeId v) const {
+    const double d = overlay_->node_delay_s(v);
+    return graph_->stop_at(v) ? add_cost(d, profile_.barrier_delay_s) : d;
+  }
 
   // Crossing the tail intersection, then driving the edge: the weight of a graph edge. Folding the
   // node cost into its out-edges makes node costs exact for every path through the node.

@@ -29,6 +29,7 @@ constexpr std::pair<const char*, double VehicleProfile::*> kNumbers[] = {
     {"turn_penalty_s", &VehicleProfile::turn_penalty_s},
     {"crossing_penalty_s", &VehicleProfile::crossing_penalty_s},
     {"uturn_penalty_s", &VehicleProfile::uturn_penalty_s},
+    {"barrier_delay_s", &VehicleProfile::barrier_delay_s},
 };
 
 void require(bool ok, const std::string& what) {
@@ -82,6 +83,8 @@ void validate(const VehicleProfile& p) {
           "crossing_penalty_s must be in [0, 120]");
   require(std::isfinite(p.uturn_penalty_s) && p.uturn_penalty_s >= 0 && p.uturn_penalty_s <= 600,
           "uturn_penalty_s must be in [0, 600]");
+  require(std::isfinite(p.barrier_delay_s) && p.barrier_delay_s >= 0 && p.barrier_delay_s <= 3600,
+          "barrier_delay_s must be in [0, 3600]");
   // Above 1 an edge could cost less than its free-flow time at the legal speed, which the landmark
   // bound assumes is the least any edge costs.
   for (double f : p.speed_factor) require(std::isfinite(f) && f > 0 && f <= 1, "speed factors must be in (0, 1]");

@@ -49,6 +49,10 @@ struct VehicleProfile {
   double crossing_penalty_s = 3.0;
   UturnPolicy uturn_policy = UturnPolicy::dead_ends;
   double uturn_penalty_s = 30.0;
+  // The time lost at each barrier the vehicle passes but stops at (maps::node_stops_vehicle: a
+  // gate, a toll booth, a border post, a bollard to lower): waiting for it to open. 30 s, as
+  // Valhalla charges for a gate; a route through one is taken only when it saves more than that.
+  double barrier_delay_s = 30.0;
   // Whether it boards ferries and shuttle trains (class ferry). Both shipped profiles do, as OSRM's
   // car does: on an island the ferry is the only way. A service whose boats take no vehicles, or
   // whose crews must never be routed onto one, sets it false.
@@ -71,7 +75,7 @@ VehicleProfile builtin_profile(std::string_view name);
 // JSON: every field optional over the ambulance's defaults, or {"base": "fire_engine", ...}.
 //   {"name", "base", "vmax_kmh", "height_m", "width_m", "weight_t", "restriction_modes": ["motorcar", ...],
 //    "except_classes": ["motorcar", "emergency", ...], "ferries", "turn_penalty_s", "crossing_penalty_s", "uturn": "dead_ends"|"anywhere",
-//    "uturn_penalty_s", "speed_factor": {"residential": 0.9, ...}}
+//    "uturn_penalty_s", "barrier_delay_s", "speed_factor": {"residential": 0.9, ...}}
 // "emergency_exceptions" (the key before except_classes) is still read: false means no `except`
 // lifts a restriction for the vehicle, true adds emergency and psv to its classes.
 // Throws ProfileError naming the field for malformed JSON, an unknown key, a wrong type, or a value

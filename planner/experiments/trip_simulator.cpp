@@ -83,6 +83,9 @@ class Vehicle {
       time_s_ += s_.signal_delay_s[at_.index()];
       r.signal_wait_s += s_.signal_delay_s[at_.index()];
     }
+    // A gate or toll booth (maps::node_stops_vehicle) holds the vehicle as long as the planner
+    // expects, preempted or not.
+    if (at_ != s_.source && g.stop_at(at_)) time_s_ += cost_.profile().barrier_delay_s;
     // The turn onto e costs what the planner charges for it (angle, crossing traffic).
     std::uint32_t vertex = e.v;
     if (!r.driven.empty()) {

@@ -346,11 +346,16 @@ std::vector<NodeId> nodes_by_osm(const RoadGraph& g, long long osm) {
   return out;
 }
 
-// True when the 200 m street from 1 to 3 is an edge (the detour around it is 400 m).
+// True when the 200 m street from 1 to 3 can be driven (the detour around it is 400 m): as one
+// edge, or as two through a barrier node the vehicle stops at.
 bool street_passes(const RoadGraph& g) {
   for (NodeId a : nodes_by_osm(g, 1)) {
     for (EdgeId out : g.out_edges(a)) {
       if (g.osm_node(g.head(out)).v == 3 && g.length_m(out) < 250.0) return true;
+      if (!g.stop_at(g.head(out))) continue;
+      for (EdgeId on : g.out_edges(g.head(out))) {
+        if (g.osm_node(g.head(on)).v == 3 && g.length_m(out) + g.length_m(on) < 250.0) return true;
+      }
     }
   }
   return false;
@@ -382,19 +387,42 @@ TEST(OsmImport, BlockingBarrierSplitsTheStreetIntoTwoDeadEnds) {
   EXPECT_FALSE(street_passes(g));
 }
 
-TEST(OsmImport, PassableNodesStayInsideTheChain) {
-  for (const auto& tags : std::vector<std::map<std::string, std::string>>{
-           {{"barrier", "bollard"}, {"bollard", "rising"}},
-           {{"barrier", "gate"}},
-           {{"barrier", "lift_gate"}, {"access", "private"}},
-           {{"barrier", "block"}, {"emergency", "yes"}},
-           {{"access", "no"}, {"emergency", "yes"}},
-           {{"barrier", "height_restrictor"}, {"maxheight", "4.2"}},
-           {{"barrier", "kerb"}, {"kerb", "lowered"}}}) {
+// Passable nodes stay inside the chain, except those the vehicle stops at: a node of their own,
+// not split.
+TEST(OsmImport, PassableNodesLetTheStreetThrough) {
+  for (const auto& [tags, stops] : std::vector<std::pair<std::map<std::string, std::string>, bool>>{
+           {{{"barrier", "bollard"}, {"bollard", "rising"}}, true},
+           {{{"barrier", "gate"}}, true},
+           {{{"barrier", "lift_gate"}, {"access", "private"}}, true},
+           {{{"barrier", "block"}, {"emergency", "yes"}}, false},
+           {{{"access", "no"}, {"emergency", "yes"}}, false},
+           {{{"barrier", "height_restrictor"}, {"maxheight", "4.2"}}, false},
+           {{{"barrier", "kerb"}, {"kerb", "lowered"}}, false}}) {
     const auto g = street_with_node(tags);
-    EXPECT_TRUE(nodes_by_osm(g, 2).empty()) << tags.begin()->first << "=" << tags.begin()->second;
+    const auto kept = nodes_by_osm(g, 2);
+    EXPECT_EQ(kept.size(), stops ? 1u : 0u) << tags.begin()->first << "=" << tags.begin()->second;
+    for (NodeId v : kept) EXPECT_TRUE(g.stop_at(v));
     EXPECT_TRUE(street_passes(g));
   }
+}
+
+// A barrier the vehicle stops at becomes a graph node of its own, flagged, where the street
+// still passes (unlike a blocking one, which splits it into two dead ends).
+TEST(OsmImport, BarriersTheVehicleStopsAtAreNodesOfTheirOwn) {
+  OsmImportReport report;
+  const auto g = street_with_node({{"barrier", "gate"}}, &report);
+  EXPECT_EQ(report.osm_stop_nodes, 1u);
+  const auto gate = nodes_by_osm(g, 2);
+  ASSERT_EQ(gate.size(), 1u);
+  EXPECT_TRUE(g.stop_at(gate.front()));
+  EXPECT_EQ(out_degree(g, gate.front()), 2u);  // both ways along the street
+  EXPECT_TRUE(street_passes(g));
+  std::size_t flagged = 0;
+  for (NodeId v : g.nodes()) flagged += g.stop_at(v) ? 1 : 0;
+  EXPECT_EQ(flagged, 1u);
+  const auto none = street_with_node({{"barrier", "cattle_grid"}});
+  EXPECT_FALSE(none.has_stops());
+  EXPECT_TRUE(nodes_by_osm(none, 2).empty());  // geometry inside the street, as before
 }
 
 TEST(OsmImport, BlockingNodeForms) {

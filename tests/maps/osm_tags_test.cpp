@@ -270,6 +270,33 @@ TEST(NodeRules, BarriersAsACarProfileReadsThem) {
   EXPECT_FALSE(blocks("height_restrictor", "maxheight", "2.5"));
 }
 
+// The barriers a vehicle passes but stops at: every kind of gate, toll booths, border posts and
+// bollards someone must lower. Not those it drives over, and not those that block it.
+TEST(NodeRules, BarriersTheVehicleStopsAt) {
+  auto stops = [](std::string_view barrier, std::string_view extra_key = {}, std::string_view extra = {}) {
+    NodeTags t;
+    t.barrier = barrier;
+    if (extra_key == "bollard") t.bollard = extra;
+    if (extra_key == "access") t.access = extra;
+    if (extra_key == "emergency") t.emergency = extra;
+    return node_stops_vehicle(t);
+  };
+  for (const char* b : {"gate", "lift_gate", "swing_gate", "sliding_gate", "bump_gate", "sally_port", "toll_booth", "border_control"}) {
+    EXPECT_TRUE(stops(b)) << b;
+  }
+  for (const char* b : {"cattle_grid", "entrance", "arch", "no", "", "height_restrictor"}) EXPECT_FALSE(stops(b)) << b;
+  for (const char* b : {"rising", "removable", "retractable", "foldable"}) EXPECT_TRUE(stops("bollard", "bollard", b)) << b;
+  EXPECT_FALSE(stops("bollard", "bollard", "flexible"));  // driven over
+  EXPECT_FALSE(stops("bollard"));                         // blocks: no route passes it
+  EXPECT_FALSE(stops("gate", "access", "no"));            // blocks
+  EXPECT_TRUE(stops("gate", "access", "private"));
+  NodeTags opened;  // access=no with emergency=yes: the ambulance passes, and still waits for it to open
+  opened.barrier = "gate";
+  opened.access = "no";
+  opened.emergency = "yes";
+  EXPECT_TRUE(node_stops_vehicle(opened));
+}
+
 TEST(WayRules, PhysicalLimitsAreReadNotJudged) {
   WayTags t;
   t.highway = "residential";

@@ -48,12 +48,12 @@ void expect_matches_dijkstra(const Planner& dstar, const TravelCost& cost, const
   }
 }
 
-// On edge-based graphs with random turn restrictions (via node and via way), under profiles that
-// differ in what binds them and in their turn and U-turn costs.
+// On edge-based graphs with random turn restrictions (via node and via way) and gates, under
+// profiles that differ in what binds them and in their turn and U-turn costs.
 TEST(DStarLite, InitialPlanMatchesDijkstraOnRandomGraphs) {
   for (std::uint64_t seed = 1; seed <= 60; ++seed) {
     const auto grid = random_grid(seed, 8, 9);
-    const auto g = testing::with_random_restrictions(grid, seed, grid.edge_count() / 6);
+    const auto g = testing::with_random_stops(testing::with_random_restrictions(grid, seed, grid.edge_count() / 6), seed, 10);
     CostOverlay overlay(g);
     overlay.set_signal_delay(g, 7.5);
     const TravelCost cost(g, overlay, testing::oracle_profile(seed, 30.0));

@@ -91,7 +91,7 @@ TEST(OneToOneSearch, UnreachableGoalIsNotFound) {
 TEST(OneToOneSearch, AStarMatchesDijkstraOnRandomGraphs) {
   for (std::uint64_t seed = 1; seed <= 40; ++seed) {
     const auto grid = testing::random_grid(seed, 10, 10);
-    const auto g = testing::with_random_restrictions(grid, seed, grid.edge_count() / 6);
+    const auto g = testing::with_random_stops(testing::with_random_restrictions(grid, seed, grid.edge_count() / 6), seed, 10);
     CostOverlay overlay(g);
     overlay.set_signal_delay(g, 12.0);
     std::mt19937_64 rng(seed);

@@ -72,6 +72,16 @@ inline maps::RoadGraph with_random_height_limits(const maps::RoadGraph& g, std::
   return maps::RoadGraph(std::move(d));
 }
 
+// `g` with a gate or toll booth (maps::RoadGraph::stop_at) on about one node in `every`, which the
+// profile's barrier_delay_s charges.
+inline maps::RoadGraph with_random_stops(const maps::RoadGraph& g, std::uint64_t seed, std::uint32_t every) {
+  std::mt19937_64 rng(seed * 104729);
+  maps::RoadGraphData d = g.data();
+  d.node_stop.assign(g.node_count(), 0);
+  for (auto& s : d.node_stop) s = std::uniform_int_distribution<std::uint32_t>(0, every - 1)(rng) == 0 ? 1 : 0;
+  return maps::RoadGraph(std::move(d));
+}
+
 // The profiles the randomized oracles cycle through: the ambulance, a fire engine, free turns, and
 // U-turns anywhere at a price.
 inline VehicleProfile oracle_profile(std::uint64_t seed, double vmax_mps) {

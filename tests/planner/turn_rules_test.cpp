@@ -404,6 +404,54 @@ TEST(TurnRules, RoundaboutIsOneStepWithItsExitNumber) {
 }
 
 
+// West (0-1), then Gate Street (1-2-3) with a gate at 2 or a 120 m longer Detour (1-5-6-3), then
+// East (3-4). With `side_road`, a dead-end Side (2-7) makes the gate's node a junction.
+maps::RoadGraph gate_map(bool side_road, bool with_detour = true) {
+  maps::testing::TempDir dir;
+  const auto file = dir.path() / "gate.osm";
+  auto named = [](const char* name) { return Tags{{"highway", "residential"}, {"name", name}}; };
+  std::vector<FixtureWay> ways{{60, {0, 1}, named("West")}, {61, {1, 2, 3}, named("Gate Street")}, {63, {3, 4}, named("East")}};
+  if (with_detour) ways.push_back({62, {1, 5, 6, 3}, named("Detour")});
+  if (side_road) ways.push_back({64, {2, 7}, named("Side")});
+  maps::testing::write_osm(file,
+                           {at(0, -100, 0), at(1, 0, 0), at(2, 100, 0, {{"barrier", "gate"}}), at(3, 200, 0), at(4, 300, 0),
+                            at(5, 0, 60), at(6, 200, 60), at(7, 100, -80)},
+                           ways, {});
+  maps::OsmImportOptions options;
+  options.show_progress = false;
+  return maps::import_osm(file, options);
+}
+
+// A gate costs the profile's barrier_delay_s: a route goes round it when that saves time, and
+// through it, charged exactly once, when there is no other way; the same for a gate at a junction.
+// A trip that ends at the gate, or starts past it, is not charged for it.
+TEST(TurnRules, AGateCostsTheProfilesBarrierDelay) {
+  VehicleProfile no_delay = ambulance_profile();
+  no_delay.barrier_delay_s = 0.0;
+  for (const bool side_road : {false, true}) {
+    const auto g = gate_map(side_road);
+    const auto from = middle_of(g, 0, 1), to = middle_of(g, 3, 4);
+    const Trip free = drive(g, no_delay, from, to);
+    EXPECT_EQ(free.ways, (std::vector<long long>{60, 61, 63})) << side_road;  // the shorter street
+    const Trip with_gate = drive(g, ambulance_profile(), from, to);
+    EXPECT_EQ(with_gate.ways, (std::vector<long long>{60, 62, 63})) << side_road;  // 120 m round is under 30 s
+    EXPECT_LT(with_gate.route.travel_time_s, free.route.travel_time_s + 30.0);
+
+    const auto only = gate_map(side_road, false);
+    const auto from_only = middle_of(only, 0, 1), to_only = middle_of(only, 3, 4);
+    auto time = [&](const VehicleProfile& p, const std::vector<EdgePoint>& a, const std::vector<EdgePoint>& b) {
+      return drive(only, p, a, b).route.travel_time_s;
+    };
+    EXPECT_NEAR(time(ambulance_profile(), from_only, to_only), time(no_delay, from_only, to_only) + 30.0, 1e-9) << side_road;
+    // Up to the gate, and on from just past it: no delay.
+    const EdgeId up_to_gate = edge(only, 1, 2), past_gate = edge(only, 2, 3);
+    const std::vector<EdgePoint> at_gate{{up_to_gate, only.length_m(up_to_gate)}};
+    const std::vector<EdgePoint> just_past{{past_gate, 1.0}};
+    EXPECT_NEAR(time(ambulance_profile(), from_only, at_gate), time(no_delay, from_only, at_gate), 1e-9) << side_road;
+    EXPECT_NEAR(time(ambulance_profile(), just_past, to_only), time(no_delay, just_past, to_only), 1e-9) << side_road;
+  }
+}
+
 // A trip that starts or ends within a metre of a junction starts or ends at it: no step of 0.3 m on
 // the street it leaves (or reaches) at once. Two metres is a real step and stays.
 TEST(TurnRules, AStepShorterThanAMetreAtEitherEndIsFoldedIntoItsNeighbour) {

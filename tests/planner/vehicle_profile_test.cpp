@@ -56,6 +56,9 @@ TEST(VehicleProfile, BadJsonIsAClearError) {
   EXPECT_NE(error_of(R"({"speed_factor": {"lane": 0.5}})").find("unknown road class"), std::string::npos);
   EXPECT_NE(error_of(R"({"base": "tank"})").find("unknown vehicle profile"), std::string::npos);
   EXPECT_NE(error_of(R"({"ferries": "sometimes"})").find("'ferries' must be true or false"), std::string::npos);
+  EXPECT_NE(error_of(R"({"barrier_delay_s": -5})").find("barrier_delay_s must be in [0, 3600]"), std::string::npos);
+  EXPECT_NE(error_of(R"({"barrier_delay_s": 7200})").find("barrier_delay_s"), std::string::npos);
+  EXPECT_DOUBLE_EQ(profile_from_json(R"({"barrier_delay_s": 0})").barrier_delay_s, 0.0);
   EXPECT_THROW((void)load_profile("/nonexistent/profile.json"), ProfileError);
 }
 
