@@ -1,6 +1,7 @@
 #include "maps/graph_builder.hpp"
 
 #include <algorithm>
+#include <stdexcept>
 #include <numeric>
 
 #include "maps/errors.hpp"
@@ -54,6 +55,9 @@ double polyline_length(const std::vector<Point2>& pts, std::uint32_t first, std:
 RoadGraph build_road_graph(const GraphBuildInput& in, GraphBuildReport* report, const GraphBuildOptions& options) {
   constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
   const auto n_in = static_cast<std::uint32_t>(in.node_pos.size());
+  if (in.node_signalized.size() != n_in || (!in.node_stop.empty() && in.node_stop.size() != n_in)) {
+    throw std::invalid_argument("build_road_graph: per-node arrays differ in length from the node positions");
+  }
 
   std::vector<DirectedEdge> edges;
   edges.reserve(in.segments.size() * 2);

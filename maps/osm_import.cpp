@@ -165,8 +165,9 @@ RoadGraph import_osm(const std::filesystem::path& path, const OsmImportOptions& 
   // The tighter of two limits, where 0 means none.
   auto tighter = [](double a, double b) { return a <= 0 ? b : b <= 0 ? a : std::min(a, b); };
 
-  // Junctions: nodes used more than once (by several ways or twice by one) and way ends. Every
-  // other node is inside a chain and only contributes geometry.
+  // Junctions: nodes used more than once (by several ways or twice by one) and way ends. Barriers
+  // are graph nodes too (a blocking one split into dead ends, one the vehicle stops at kept whole).
+  // Every other node is inside a chain and only contributes geometry.
   std::vector<osmium::object_id_type> sorted_refs;
   sorted_refs.reserve(c.refs.size());
   for (std::size_t i = 0; i < c.refs.size(); ++i) {
@@ -247,15 +248,19 @@ RoadGraph import_osm(const std::filesystem::path& path, const OsmImportOptions& 
         std::uint32_t from = junction(i);
         auto first_point = static_cast<std::uint32_t>(in.points.size());
         in.points.push_back(in.node_pos[from]);
+        // A signal between two junctions marks the nearer one. A gate is a graph node but no
+        // junction: the distances run from the last junction (`anchor`) across it.
+        std::uint32_t anchor = from;
         double along = 0.0;
         double segment_height = tighter(way.rules.max_height_m, node_height_limit(c.refs[i]));
-        std::vector<std::pair<std::uint32_t, double>> interior_signals;  // ref index, distance from start
+        std::vector<std::pair<std::uint32_t, double>> interior_signals;  // ref index, distance from anchor
         for (std::uint32_t k = i + 1; k < run_end; ++k) {
           const Point2 p = projection.to_local({c.locations[k].lat(), c.locations[k].lon()});
           along += distance_m(in.points.back(), p);
           segment_height = tighter(segment_height, node_height_limit(c.refs[k]));
+          const bool real_junction = k + 1 == run_end || use_count(c.refs[k]) >= 2 || is_barrier(c.refs[k]);
           // A gate the vehicle stops at is a node of its own too, where its delay is charged.
-          const bool is_junction = k + 1 == run_end || use_count(c.refs[k]) >= 2 || is_barrier(c.refs[k]) || is_stop(c.refs[k]);
+          const bool is_junction = real_junction || is_stop(c.refs[k]);
           if (!is_junction) {
             in.points.push_back(p);
             if (is_signal(c.refs[k])) interior_signals.emplace_back(k, along);
@@ -281,14 +286,17 @@ RoadGraph import_osm(const std::filesystem::path& path, const OsmImportOptions& 
           seg.max_weight_t = static_cast<float>(way.rules.max_weight_t);
           seg.roundabout = way.rules.roundabout;
           in.segments.push_back(seg);
-          for (const auto& [ref_i, d] : interior_signals) {
-            const double to_end = along - d;
-            signal_marks.push_back(d <= to_end ? PendingSignal{from, d} : PendingSignal{to, to_end});
-          }
-          interior_signals.clear();
           // Past a barrier, the next segment starts from the barrier's other side.
           from = is_barrier(c.refs[k]) && k + 1 < run_end ? junction(k) : to;
-          along = 0.0;
+          if (real_junction) {
+            for (const auto& [ref_i, d] : interior_signals) {
+              const double to_end = along - d;
+              signal_marks.push_back(d <= to_end ? PendingSignal{anchor, d} : PendingSignal{to, to_end});
+            }
+            interior_signals.clear();
+            anchor = from;
+            along = 0.0;
+          }
           segment_height = tighter(way.rules.max_height_m, node_height_limit(c.refs[k]));
           first_point = static_cast<std::uint32_t>(in.points.size());
           in.points.push_back(in.node_pos[from]);

@@ -1,5 +1,6 @@
 // Reads .osm, .osm.gz, .osm.bz2 and .osm.pbf files with libosmium into a RoadGraph for emergency
-// vehicles: drivable ways, degree-2 chains compressed into edges, signalized intersections marked.
+// vehicles: drivable ways, degree-2 chains compressed into edges, signalized intersections and
+// barriers marked.
 #pragma once
 
 #include <filesystem>

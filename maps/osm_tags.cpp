@@ -215,10 +215,14 @@ bool node_blocks_emergency(const NodeTags& t) {
 }
 
 bool node_stops_vehicle(const NodeTags& t) {
-  if (node_blocks_emergency(t)) return false;
-  if (t.barrier == "bollard") return is_one_of(t.bollard, {"rising", "removable", "retractable", "foldable"});
-  return is_one_of(t.barrier,
-                   {"gate", "lift_gate", "swing_gate", "sliding_gate", "bump_gate", "sally_port", "toll_booth", "border_control"});
+  if (t.barrier.empty() || node_blocks_emergency(t)) return false;
+  // Driven over or through at speed.
+  if (is_one_of(t.barrier, {"no", "cattle_grid", "entrance", "arch", "height_restrictor", "kerb"})) return false;
+  if (t.barrier == "bollard" && t.bollard == "flexible") return false;
+  // A gate open to everyone stands open (Valhalla, too, charges a gate only where its access is
+  // unknown or private).
+  if (t.barrier.find("gate") != std::string_view::npos && is_one_of(t.access, {"yes", "permissive"})) return false;
+  return true;
 }
 
 std::optional<double> parse_maxspeed_kmh(std::string_view raw) {

@@ -116,12 +116,14 @@ std::optional<double> parse_weight_t(std::string_view value);
 // emergency=yes|designated on the node lets the vehicle through any of these.
 bool node_blocks_emergency(const NodeTags& tags);
 
-// True for a barrier the vehicle passes but must stop at: a gate of any kind (gate, lift_gate,
-// swing_gate, sliding_gate, bump_gate, sally_port), a toll booth, a border post, or a bollard that
-// someone must lower or remove (rising, removable, retractable, foldable; a flexible one is driven
-// over). The profile charges a delay for each (planner::VehicleProfile::barrier_delay_s), as
-// Valhalla's gate and toll booth costs do. False for a barrier that blocks the vehicle: no route
-// passes it at all.
+// True for a barrier the vehicle passes but must stop at: a gate the car profile lets through
+// (gate, lift_gate, swing_gate, sliding_gate, bump_gate, sally_port) unless access=yes|permissive
+// keeps it open, a toll booth, a border post, a bollard someone must lower or remove (rising,
+// removable, retractable, foldable), and any barrier that only emergency=yes lets it through
+// (a block, a chain, a fixed bollard). Not what it drives over: a cattle grid, an entrance, an
+// arch, a kerb, a flexible bollard, a height restrictor. The profile charges a delay for each
+// (planner::VehicleProfile::barrier_delay_s), as Valhalla's gate cost does. False for a barrier that
+// blocks the vehicle: no route passes it at all.
 bool node_stops_vehicle(const NodeTags& tags);
 
 // A maxspeed value in km/h: plain numbers, "mph" and "knots" units, "none", "walk", and the implicit

@@ -58,6 +58,7 @@ void validate(const RoadGraphData& d) {
             "edge limit is not a finite non-negative number");
   }
   require(d.node_stop.empty() || d.node_stop.size() == n, "barrier stops do not cover the nodes");
+  require(std::all_of(d.node_stop.begin(), d.node_stop.end(), [](std::uint8_t s) { return s <= 1; }), "barrier stop flag is not 0 or 1");
   for (std::size_t i = 0; i < d.roundabout_edges.size(); ++i) {
     require(d.roundabout_edges[i].index() < m && (i == 0 || d.roundabout_edges[i - 1] < d.roundabout_edges[i]),
             "roundabout edges unsorted or out of range");

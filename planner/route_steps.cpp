@@ -23,10 +23,13 @@ int roundabout_exit(const maps::RoadGraph& g, const std::vector<EdgeId>& edges, 
 }
 
 // Folds a first step shorter than min_m into the second (which becomes the depart, from the trip's
-// start), and a last one into the one before it. A roundabout step is never dropped: its exit
-// count is the instruction. At least one step always stays.
+// start), and a last one into the one before it. A roundabout step (its exit count) and a U-turn
+// are never folded away: they are the instruction. At least one step always stays.
 void trim_end_steps(std::vector<RouteStep>& steps, double min_m) {
-  if (steps.size() >= 2 && steps.front().distance_m < min_m && steps[1].maneuver != ManeuverType::roundabout) {
+  auto keeps_instruction = [](const RouteStep& s) {
+    return s.maneuver == ManeuverType::roundabout || s.modifier == TurnModifier::uturn;
+  };
+  while (steps.size() >= 2 && steps.front().distance_m < min_m && !keeps_instruction(steps[1])) {
     RouteStep& next = steps[1];
     next.distance_m += steps.front().distance_m;
     next.duration_s += steps.front().duration_s;
@@ -36,7 +39,7 @@ void trim_end_steps(std::vector<RouteStep>& steps, double min_m) {
     next.turn_deg = 0;
     steps.erase(steps.begin());
   }
-  if (steps.size() >= 2 && steps.back().distance_m < min_m && steps.back().maneuver != ManeuverType::roundabout) {
+  while (steps.size() >= 2 && steps.back().distance_m < min_m && !keeps_instruction(steps.back())) {
     RouteStep& previous = steps[steps.size() - 2];
     previous.distance_m += steps.back().distance_m;
     previous.duration_s += steps.back().duration_s;
@@ -130,7 +133,9 @@ std::vector<RouteStep> route_steps(const maps::RoadGraph& g, const Route& route,
         // (Straight off a roundabout onto a ferry: boarding is a step of its own.)
         const double turn = turn_between(g, in, out);
         const bool renamed = g.name(in) != g.name(out) || g.ref(in) != g.ref(out);
-        const bool sharp = std::abs(turn) >= options.continue_turn_deg;
+        // A bend at a gate inside one way is no maneuver: the gate is a node only for its delay.
+        const bool along_way_at_gate = g.stop_at(g.tail(out)) && g.osm_way(in) == g.osm_way(out);
+        const bool sharp = std::abs(turn) >= options.continue_turn_deg && !along_way_at_gate;
         if (renamed || sharp || boards_or_leaves) {
           RouteStep s;
           s.name = g.name(out);

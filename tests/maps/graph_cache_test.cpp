@@ -49,7 +49,7 @@ TEST(GraphCache, RoundTripPreservesTheGraph) {
   EXPECT_EQ(source, (CacheSource{123, 456}));
 }
 
-// Turn restrictions, limits and roundabouts survive the cache; the turn graph rebuilt from them on
+// Turn restrictions, limits, roundabouts and gates survive the cache; the turn graph rebuilt from them on
 // load is the same.
 TEST(GraphCache, RoundTripKeepsTheTurnModel) {
   TempDir dir;
@@ -60,6 +60,8 @@ TEST(GraphCache, RoundTripKeepsTheTurnModel) {
   d.edge_limits.push_back({a, 3.2f, 0.0f, 7.5f});
   d.roundabout_edges.push_back(b);
   d.left_hand_traffic = {1};
+  d.node_stop.assign(d.node_x_m.size(), 0);
+  d.node_stop[3] = 1;
   const RoadGraph g(std::move(d));
   const auto file = dir.path() / "t.cgr";
   write_graph_cache(file, g, CacheSource{1, 2});
@@ -71,6 +73,8 @@ TEST(GraphCache, RoundTripKeepsTheTurnModel) {
   EXPECT_FLOAT_EQ(back.edge_limits()[0].max_height_m, 3.2f);
   EXPECT_TRUE(back.on_roundabout(b));
   EXPECT_TRUE(back.left_hand_traffic());
+  EXPECT_EQ(back.data().node_stop, g.data().node_stop);
+  EXPECT_TRUE(back.stop_at(NodeId{3}));
   EXPECT_EQ(back.turns().arc_count(), g.turns().arc_count());
 }
 

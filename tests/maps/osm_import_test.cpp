@@ -394,8 +394,9 @@ TEST(OsmImport, PassableNodesLetTheStreetThrough) {
            {{{"barrier", "bollard"}, {"bollard", "rising"}}, true},
            {{{"barrier", "gate"}}, true},
            {{{"barrier", "lift_gate"}, {"access", "private"}}, true},
-           {{{"barrier", "block"}, {"emergency", "yes"}}, false},
+           {{{"barrier", "block"}, {"emergency", "yes"}}, true},
            {{{"access", "no"}, {"emergency", "yes"}}, false},
+           {{{"barrier", "gate"}, {"access", "yes"}}, false},
            {{{"barrier", "height_restrictor"}, {"maxheight", "4.2"}}, false},
            {{{"barrier", "kerb"}, {"kerb", "lowered"}}, false}}) {
     const auto g = street_with_node(tags);
@@ -423,6 +424,19 @@ TEST(OsmImport, BarriersTheVehicleStopsAtAreNodesOfTheirOwn) {
   const auto none = street_with_node({{"barrier", "cattle_grid"}});
   EXPECT_FALSE(none.has_stops());
   EXPECT_TRUE(nodes_by_osm(none, 2).empty());  // geometry inside the street, as before
+}
+
+// A gate is a graph node but no junction: a signal 10 m past it and 30 m from the junction behind
+// it marks the junction, not the gate.
+TEST(OsmImport, ASignalNearAGateMarksTheJunctionNotTheGate) {
+  const auto g = import_fixture({at(1, 0, 0), at(2, 20, 0, {{"barrier", "gate"}}), at(3, 30, 0, {{"highway", "traffic_signals"}}),
+                                 at(4, 100, 0), at(5, 100, 100), at(6, 0, 100)},
+                                {{60, {1, 2, 3, 4}, kResidential}, {61, {4, 5, 6, 1}, kResidential}});
+  ASSERT_EQ(nodes_by_osm(g, 2).size(), 1u);
+  EXPECT_FALSE(g.signalized(nodes_by_osm(g, 2).front()));
+  ASSERT_EQ(nodes_by_osm(g, 1).size(), 1u);
+  EXPECT_TRUE(g.signalized(nodes_by_osm(g, 1).front()));
+  EXPECT_FALSE(g.signalized(nodes_by_osm(g, 4).front()));
 }
 
 TEST(OsmImport, BlockingNodeForms) {

@@ -290,6 +290,10 @@ TEST(NodeRules, BarriersTheVehicleStopsAt) {
   EXPECT_FALSE(stops("bollard"));                         // blocks: no route passes it
   EXPECT_FALSE(stops("gate", "access", "no"));            // blocks
   EXPECT_TRUE(stops("gate", "access", "private"));
+  EXPECT_FALSE(stops("gate", "access", "yes"));  // open to everyone: it stands open
+  EXPECT_FALSE(stops("lift_gate", "access", "permissive"));
+  EXPECT_TRUE(stops("toll_booth", "access", "yes"));
+  for (const char* b : {"bollard", "block", "chain"}) EXPECT_TRUE(stops(b, "emergency", "yes")) << b;  // only for it
   NodeTags opened;  // access=no with emergency=yes: the ambulance passes, and still waits for it to open
   opened.barrier = "gate";
   opened.access = "no";

@@ -98,7 +98,8 @@ TEST(CchMetric, PartialCustomizationEqualsFullCustomization) {
   for (std::uint64_t seed = 1; seed <= 40; ++seed) {
     const auto grid = random_grid(seed, 7, 8);
     // Height limits too: the fire engine (every fourth seed) is kept off those edges for good.
-    const auto g = testing::with_random_height_limits(testing::with_random_restrictions(grid, seed, grid.edge_count() / 8), seed, 12);
+    const auto g = testing::with_random_stops(
+        testing::with_random_height_limits(testing::with_random_restrictions(grid, seed, grid.edge_count() / 8), seed, 12), seed, 9);
     CostOverlay overlay(g);
     const TravelCost cost(g, overlay, testing::oracle_profile(seed, 25.0));
     const CchTopology t(g.turns());
@@ -149,7 +150,7 @@ TEST(CchMetric, LazyRisesSettleToTheFullCustomization) {
   int settled = 0, raised_total = 0;
   for (std::uint64_t seed = 1; seed <= 30; ++seed) {
     const auto grid = random_grid(seed, 7, 8);
-    const auto g = testing::with_random_restrictions(grid, seed, grid.edge_count() / 8);
+    const auto g = testing::with_random_stops(testing::with_random_restrictions(grid, seed, grid.edge_count() / 8), seed, 9);
     CostOverlay overlay(g);
     const TravelCost cost(g, overlay, testing::oracle_profile(seed, 25.0));
     const CchTopology t(g.turns());

@@ -90,6 +90,7 @@ inline VehicleProfile oracle_profile(std::uint64_t seed, double vmax_mps) {
     p.uturn_policy = UturnPolicy::anywhere;
     p.uturn_penalty_s = 12.0;
     p.except_classes = 0;
+    p.barrier_delay_s = 45.0;
   }
   p.vmax_mps = vmax_mps;
   return p;

@@ -452,6 +452,31 @@ TEST(TurnRules, AGateCostsTheProfilesBarrierDelay) {
   }
 }
 
+// A gate on a bend inside one way adds its delay and nothing else: the bend there is no turn (no
+// turn cost, no step), as it was before the gate made the bend a node.
+TEST(TurnRules, AGateOnABendIsNoTurn) {
+  auto bend_map = [](bool gate) {
+    maps::testing::TempDir dir;
+    const auto file = dir.path() / "bend.osm";
+    auto named = [](const char* name) { return Tags{{"highway", "residential"}, {"name", name}}; };
+    maps::testing::write_osm(file,
+                             {at(0, -100, 0), at(1, 0, 0), at(2, 100, 0, gate ? Tags{{"barrier", "gate"}} : Tags{}), at(3, 100, 100),
+                              at(4, 100, 200)},
+                             {{60, {0, 1}, named("West")}, {70, {1, 2, 3}, named("Bend Road")}, {63, {3, 4}, named("North")}}, {});
+    maps::OsmImportOptions options;
+    options.show_progress = false;
+    return maps::import_osm(file, options);
+  };
+  const auto with_gate = bend_map(true), without = bend_map(false);
+  const Trip through = drive(with_gate, ambulance_profile(), middle_of(with_gate, 0, 1), middle_of(with_gate, 3, 4));
+  const Trip plain = drive(without, ambulance_profile(), middle_of(without, 0, 1), middle_of(without, 3, 4));
+  ASSERT_TRUE(through.route.found && plain.route.found);
+  EXPECT_NEAR(through.route.travel_time_s, plain.route.travel_time_s + ambulance_profile().barrier_delay_s, 1e-9);
+  std::vector<std::string> names;
+  for (const RouteStep& st : route_steps(with_gate, through.route)) names.push_back(st.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"West", "Bend Road", "North", "North"}));
+}
+
 // A trip that starts or ends within a metre of a junction starts or ends at it: no step of 0.3 m on
 // the street it leaves (or reaches) at once. Two metres is a real step and stays.
 TEST(TurnRules, AStepShorterThanAMetreAtEitherEndIsFoldedIntoItsNeighbour) {
