@@ -262,6 +262,31 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
         if (changed_set.insert(touched.v).second) changed.push_back(touched);
       }
 
+      // The lazy hierarchy goes first, straight after the batch: the searches that follow read
+      // the same graph, overlay and hierarchy, and would warm its caches. (It went after the
+      // eager hierarchy until session 14, which flattered it by about 15 % at p50.)
+      double lazy_custom_ms = 0, lazy_repair_ms = 0;
+      planner::SettledReplan lazy;
+      if (lazy_dstar) {
+        t0 = Clock::now();
+        lazy_arcs.clear();
+        (void)lazy_metric->edges_changed(changed, lazy_arcs);
+        lazy_custom_ms = ms_since(t0);
+        t0 = Clock::now();
+        lazy_dstar->move_start({*position});
+        lazy_dstar->edges_changed(changed);
+        lazy_dstar->arcs_changed(lazy_arcs);
+        lazy = planner::replan_settled(*lazy_metric, *lazy_dstar);
+        lazy_repair_ms = ms_since(t0);
+        t_lazy_custom.push_back(lazy_custom_ms);
+        t_lazy_repair.push_back(lazy_repair_ms);
+        t_lazy.push_back(lazy_custom_ms + lazy_repair_ms);
+        lazy_changed += static_cast<double>(lazy_arcs.size());
+        lazy_repairs += lazy.repairs;
+        lazy_settled += static_cast<double>(lazy.settled);
+        res.lazy_max_repairs = std::max<std::uint64_t>(res.lazy_max_repairs, lazy.repairs);
+      }
+
       t0 = Clock::now();
       dstar.move_start({*position});
       dstar.edges_changed(changed);
@@ -294,28 +319,6 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
         cch_changed += static_cast<double>(changed_arcs.size());
         cch_expanded += static_cast<double>(cch_stats.expanded);
         cch_vertices += static_cast<double>(cch_dstar->space().upward_size() + cch_dstar->space().downward_size());
-      }
-
-      double lazy_custom_ms = 0, lazy_repair_ms = 0;
-      planner::SettledReplan lazy;
-      if (lazy_dstar) {
-        t0 = Clock::now();
-        lazy_arcs.clear();
-        (void)lazy_metric->edges_changed(changed, lazy_arcs);
-        lazy_custom_ms = ms_since(t0);
-        t0 = Clock::now();
-        lazy_dstar->move_start({*position});
-        lazy_dstar->edges_changed(changed);
-        lazy_dstar->arcs_changed(lazy_arcs);
-        lazy = planner::replan_settled(*lazy_metric, *lazy_dstar);
-        lazy_repair_ms = ms_since(t0);
-        t_lazy_custom.push_back(lazy_custom_ms);
-        t_lazy_repair.push_back(lazy_repair_ms);
-        t_lazy.push_back(lazy_custom_ms + lazy_repair_ms);
-        lazy_changed += static_cast<double>(lazy_arcs.size());
-        lazy_repairs += lazy.repairs;
-        lazy_settled += static_cast<double>(lazy.settled);
-        res.lazy_max_repairs = std::max<std::uint64_t>(res.lazy_max_repairs, lazy.repairs);
       }
 
       const planner::SearchSpace space(cost, {*position}, {goal});
