@@ -240,17 +240,20 @@ TEST(WayRules, DirectionalAccessClosesOneDirection) {
   EXPECT_TRUE(interpret_way(t).has_value());
 }
 
+// A node with `barrier` and, optionally, one more tag.
+NodeTags barrier_node(std::string_view barrier, std::string_view extra_key = {}, std::string_view extra = {}) {
+  NodeTags t;
+  t.barrier = barrier;
+  if (extra_key == "bollard") t.bollard = extra;
+  if (extra_key == "kerb") t.kerb = extra;
+  if (extra_key == "maxheight") t.maxheight = extra;
+  if (extra_key == "access") t.access = extra;
+  if (extra_key == "emergency") t.emergency = extra;
+  return t;
+}
+
 TEST(NodeRules, BarriersAsACarProfileReadsThem) {
-  auto blocks = [](std::string_view barrier, std::string_view extra_key = {}, std::string_view extra = {}) {
-    NodeTags t;
-    t.barrier = barrier;
-    if (extra_key == "bollard") t.bollard = extra;
-    if (extra_key == "kerb") t.kerb = extra;
-    if (extra_key == "maxheight") t.maxheight = extra;
-    if (extra_key == "access") t.access = extra;
-    if (extra_key == "emergency") t.emergency = extra;
-    return node_blocks_emergency(t);
-  };
+  auto blocks = [](auto... tags) { return node_blocks_emergency(barrier_node(tags...)); };
   for (const char* b : {"bollard", "block", "wall", "fence", "chain", "kerb", "cycle_barrier", "turnstile", "unknown"}) {
     EXPECT_TRUE(blocks(b)) << b;
   }
@@ -273,14 +276,7 @@ TEST(NodeRules, BarriersAsACarProfileReadsThem) {
 // The barriers a vehicle passes but stops at: every kind of gate, toll booths, border posts and
 // bollards someone must lower. Not those it drives over, and not those that block it.
 TEST(NodeRules, BarriersTheVehicleStopsAt) {
-  auto stops = [](std::string_view barrier, std::string_view extra_key = {}, std::string_view extra = {}) {
-    NodeTags t;
-    t.barrier = barrier;
-    if (extra_key == "bollard") t.bollard = extra;
-    if (extra_key == "access") t.access = extra;
-    if (extra_key == "emergency") t.emergency = extra;
-    return node_stops_vehicle(t);
-  };
+  auto stops = [](auto... tags) { return node_stops_vehicle(barrier_node(tags...)); };
   for (const char* b : {"gate", "lift_gate", "swing_gate", "sliding_gate", "bump_gate", "sally_port", "toll_booth", "border_control"}) {
     EXPECT_TRUE(stops(b)) << b;
   }
@@ -294,9 +290,7 @@ TEST(NodeRules, BarriersTheVehicleStopsAt) {
   EXPECT_FALSE(stops("lift_gate", "access", "permissive"));
   EXPECT_TRUE(stops("toll_booth", "access", "yes"));
   for (const char* b : {"bollard", "block", "chain"}) EXPECT_TRUE(stops(b, "emergency", "yes")) << b;  // only for it
-  NodeTags opened;  // access=no with emergency=yes: the ambulance passes, and still waits for it to open
-  opened.barrier = "gate";
-  opened.access = "no";
+  NodeTags opened = barrier_node("gate", "access", "no");  // with emergency=yes: it passes, and waits for it to open
   opened.emergency = "yes";
   EXPECT_TRUE(node_stops_vehicle(opened));
 }
