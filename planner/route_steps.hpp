@@ -44,9 +44,9 @@ struct StepOptions {
 TurnModifier modifier_for_turn(double turn_deg);
 
 // Depart, one step per street (or per sharp turn on one street, or per boarding or leaving a
-// ferry), arrive; a first or last step shorter than min_end_step_m is folded into its neighbour. A roundabout is one step,
-// "roundabout" with the exit to take, named after the road it leaves by, as OSRM gives it. Empty for
-// a route not found.
+// ferry), arrive. A roundabout is one step, "roundabout" with the exit to take, named after the road
+// it leaves by, as OSRM gives it. A first or last step shorter than min_end_step_m is folded into its
+// neighbour. Empty for a route not found.
 std::vector<RouteStep> route_steps(const maps::RoadGraph& graph, const Route& route, const StepOptions& options = {});
 
 }  // namespace corridor::planner
