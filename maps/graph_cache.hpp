@@ -12,11 +12,12 @@ namespace corridor::maps {
 
 // Bumped whenever the importer reads OSM differently, too: a cache stays valid only for the rules
 // that built it.
-inline constexpr std::uint32_t kGraphCacheVersion = 10;  // 2: names and refs; 3: ALT landmarks; 4: barriers, access; 5: turns;
+inline constexpr std::uint32_t kGraphCacheVersion = 11;  // 2: names and refs; 3: ALT landmarks; 4: barriers, access; 5: turns;
                                                          // 6: every strongly connected component kept; 7: *_on_red not a ban;
                                                          // 8: landmarks on the main component only;
                                                          // 9: except as a vehicle class mask, ferries;
-                                                         // 10: barriers the vehicle stops at
+                                                         // 10: barriers the vehicle stops at;
+                                                         // 11: open gates (access=yes) are no stop
 
 struct CacheSource {
   std::uint64_t size_bytes = 0;
