@@ -19,6 +19,10 @@ CchMetric::CchMetric(const CchTopology& topology, const TravelCost& cost, CchMet
       via_down_(topology.arc_count(), kNoCchArc),
       slot_(topology.arc_count(), 0),
       queue_(topology.arc_count()) {
+  if (options_.lazy_rises) {
+    input_up_.resize(topology.arc_count());
+    input_down_.resize(topology.arc_count());
+  }
   if (&topology.turns() != &cost.graph().turns()) {
     throw std::invalid_argument("the contraction hierarchy was built for another graph than the cost model's");
   }
@@ -26,8 +30,9 @@ CchMetric::CchMetric(const CchTopology& topology, const TravelCost& cost, CchMet
   customize_all(open_);
   build_open_lists();
   if (options_.lazy_rises) {
-    // Every weight of a full customization is exact: found so in batch 1, before any change.
-    changed_below_.assign(topology.vertex_count(), 0);
+    // Every weight of a full customization is exact: found so in batch 1, before any change (and
+    // no subtree has seen a rise since).
+    changed_below_.assign(topology.vertex_count(), batch_);
     parent_.resize(topology.vertex_count());
     for (std::uint32_t r = 0; r < topology.vertex_count(); ++r) parent_[r] = topology.parent(r);
     exact_up_.assign(topology.arc_count(), batch_);
@@ -59,6 +64,10 @@ void CchMetric::customize_all(std::vector<std::uint8_t>& open) {
     const CchTopology::Input& in = t.input(arc);
     up_[arc] = in.up == kNoCchArc ? kInfCost : input_s(in.up);
     down_[arc] = in.down == kNoCchArc ? kInfCost : input_s(in.down);
+    if (options_.lazy_rises) {
+      input_up_[arc] = up_[arc];
+      input_down_[arc] = down_[arc];
+    }
   }
   // Basic customization: every lower triangle {x, a, b} (x lowest) offers a→x→b and b→x→a. Going
   // up by x, an arc's weight is final before any arc above it reads it. The same sweep opens a→b
@@ -162,8 +171,7 @@ std::uint32_t tail_of(const CchDownArc& d) { return d.tail; }
 
 CchMetric::Derived CchMetric::derive(std::uint32_t arc, bool upward) const {
   const CchTopology& t = *topology_;
-  const std::uint32_t input = upward ? t.input(arc).up : t.input(arc).down;
-  Derived d{input == kNoCchArc ? kInfCost : input_s(input), kNoCchArc};
+  Derived d{input_cost(arc, upward), kNoCchArc};
   const std::uint32_t x = t.tail(arc), y = t.head(arc);
   // Lower triangles {z, x, y}, z below x, open the way asked: x→z→y upward, y→z→x downward.
   // Both lists ascend by z.
@@ -219,9 +227,7 @@ void CchMetric::queue_turns_into(std::uint32_t v) {
   for (const maps::TurnArc& a : t.turns().arcs_in(v)) {
     if (a.other == v) continue;
     const std::uint32_t ru = t.rank(a.other), rv = t.rank(v);
-    const std::uint32_t arc = t.find_arc(ru, rv);
-    mark_changed(arc);
-    queue(arc, ru < rv ? kUp : kDown);
+    queue(t.find_arc(ru, rv), ru < rv ? kUp : kDown);
   }
 }
 
@@ -230,9 +236,7 @@ void CchMetric::queue_turns_out_of(std::uint32_t v) {
   for (const maps::TurnArc& a : t.turns().arcs_out(v)) {
     if (a.other == v) continue;
     const std::uint32_t rv = t.rank(v), rw = t.rank(a.other);
-    const std::uint32_t arc = t.find_arc(rv, rw);
-    mark_changed(arc);
-    queue(arc, rv < rw ? kUp : kDown);
+    queue(t.find_arc(rv, rw), rv < rw ? kUp : kDown);
   }
 }
 
@@ -275,9 +279,13 @@ CustomizationStats CchMetric::propagate(std::vector<std::uint32_t>& changed) {
       double& w = upward ? up_[arc] : down_[arc];
       std::uint32_t& via = upward ? via_up_[arc] : via_down_[arc];
       if (options_.lazy_rises) {
-        // Only a cheaper input can move a lower bound down; a dearer one waits for settle().
+        // Only a cheaper input can move a lower bound down; a dearer one waits for settle(), and
+        // from now on every weight whose path may use it is stale (mark_changed).
         const std::uint32_t input = upward ? t.input(arc).up : t.input(arc).down;
         const double in = input == kNoCchArc ? kInfCost : input_s(input);
+        double& kept = upward ? input_up_[arc] : input_down_[arc];
+        if (in > kept) mark_changed(arc);
+        kept = in;
         if (in < w) {
           w = in;
           via = kNoCchArc;
@@ -293,6 +301,14 @@ CustomizationStats CchMetric::propagate(std::vector<std::uint32_t>& changed) {
     if (!up_moved && !down_moved) continue;
     ++stats.changed;
     changed.push_back(arc);
+    if (options_.lazy_rises) {
+      // A lower bound that a fall moved (down) is not known to be exact: settle() must look. One
+      // that did not move is exact still: it lies at or below today's cost, which a fall cannot
+      // have raised above the cost it was found exact at. So a fall marks only the weights it
+      // moves, where a rise marks its whole subtree.
+      if (up_moved) exact_up_[arc] = 0;
+      if (down_moved) exact_down_[arc] = 0;
+    }
     // {x, y} is a lower side of every triangle {x, y, z} with z above x; the triangle's arc
     // between y and z is offered y→x→z (riding on y→x) and z→x→y (riding on x→y). Only open
     // directions x→z and z→x can carry anything.
@@ -368,8 +384,7 @@ double CchMetric::settle(std::uint32_t arc, bool upward, std::vector<std::uint32
     const std::uint32_t z = upward ? via_up_[arc] : via_down_[arc];
     double witnessed = kInfCost;
     if (z == kNoCchArc) {
-      const std::uint32_t input = upward ? t.input(arc).up : t.input(arc).down;
-      if (input != kNoCchArc) witnessed = input_s(input);
+      witnessed = input_cost(arc, upward);
     } else {
       // x→z→y upward, y→z→x downward, z below both (as unpack follows them).
       const std::uint32_t zx = t.find_arc(z, t.tail(arc)), zy = t.find_arc(z, t.head(arc));
@@ -393,6 +408,14 @@ double CchMetric::settle(std::uint32_t arc, bool upward, std::vector<std::uint32
 std::string CchMetric::invariant_violation() const {
   const CchTopology& t = *topology_;
   for (std::uint32_t arc = 0; arc < t.arc_count(); ++arc) {
+    for (const bool upward : {true, false}) {
+      const std::uint32_t input = upward ? t.input(arc).up : t.input(arc).down;
+      const double today = input == kNoCchArc ? kInfCost : input_s(input);
+      if (input_cost(arc, upward) != today) {
+        return "arc " + std::to_string(arc) + (upward ? " up" : " down") + " keeps input cost " +
+               std::to_string(input_cost(arc, upward)) + " but the turn costs " + std::to_string(today) + " today";
+      }
+    }
     const double up = derive(arc, true).weight, down = derive(arc, false).weight;
     if (options_.lazy_rises) {
       // Lower bounds: at or below what the triangles and the input give; witnesses may have risen.
@@ -432,7 +455,7 @@ std::string CchMetric::invariant_violation() const {
 }
 
 std::size_t CchMetric::memory_bytes() const {
-  return (up_.size() + down_.size()) * sizeof(double) +
+  return (up_.size() + down_.size() + input_up_.size() + input_down_.size()) * sizeof(double) +
          (via_up_.size() + via_down_.size() + slot_.size() + changed_below_.size() + parent_.size() + exact_up_.size() +
           exact_down_.size()) *
              sizeof(std::uint32_t) +

@@ -156,12 +156,22 @@ class CchMetric {
   // Lazy rises: what settle() need not look at again. Each report of changes is a new batch. An
   // arc's weight, and the cheapest path below it, depend only on the inputs of arcs whose lower
   // end lies in the arc's lower end's elimination subtree (its triangles' middles are lower
-  // neighbours, so descendants). An arc found exact in a batch no earlier than the last change in
-  // that subtree is exact still, and settle() returns at once instead of walking what it unpacks to.
+  // neighbours, so descendants). An arc found exact in a batch no earlier than the last rise in
+  // that subtree is exact still, unless a fall has moved its weight since (which sets its batch
+  // to 0), and settle() returns at once instead of walking what it unpacks to. Marking falls by
+  // the weights they move, not by subtree, cut the Porto bench's p50 and p99 by 5–10 %.
   std::uint32_t batch_ = 1;
-  std::vector<std::uint32_t> changed_below_;           // by rank: the batch of the last input change in its subtree
+  std::vector<std::uint32_t> changed_below_;           // by rank: the batch of the last input rise in its subtree
   std::vector<std::uint32_t> parent_;                  // by rank: the topology's parent(), in one array for the climb
   std::vector<std::uint32_t> exact_up_, exact_down_;  // by arc: the batch its weight was last found exact in
+  // Lazy rises: each input's cost as of the last change reported for it. A rise is told from a
+  // fall by it, and settle() reads it instead of the graph and the overlay.
+  std::vector<double> input_up_, input_down_;
+  [[nodiscard]] double input_cost(std::uint32_t arc, bool upward) const {
+    if (options_.lazy_rises) return upward ? input_up_[arc] : input_down_[arc];
+    const std::uint32_t input = upward ? topology_->input(arc).up : topology_->input(arc).down;
+    return input == kNoCchArc ? kInfCost : input_s(input);
+  }
   void mark_changed(std::uint32_t arc);
   const void* settler_ = nullptr;
 };
