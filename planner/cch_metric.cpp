@@ -218,6 +218,11 @@ void CchMetric::offer(std::uint32_t arc, bool upward, double old_s, double new_s
     // The path through this triangle was (one of) the arc's cheapest and got dearer: only a full
     // look at its triangles tells its new weight.
     queue(arc, upward ? kUp : kDown);
+  } else if (options_.lazy_rises && new_s < old_s && (upward ? via_up_[arc] : via_down_[arc]) == via) {
+    // The arc's own witness got cheaper and the weight did not move: the fall vanished in
+    // rounding. The path under the weight changed all the same (a side took a new witness), so
+    // the arc and every arc above it must be looked at again, as after a rise.
+    mark_changed(arc);
   }
 }
 
@@ -361,7 +366,7 @@ void CchMetric::unpack(std::uint32_t arc, bool upward, std::vector<std::uint32_t
     return;
   }
   // A shortcut: x→z→y upward, y→z→x downward, z below both.
-  const std::uint32_t zx = t.find_arc(z, x), zy = t.find_arc(z, y);
+  const auto [zx, zy] = t.find_arcs_up(z, x, y);
   if (upward) {
     unpack(zx, false, out);
     unpack(zy, true, out);
@@ -379,7 +384,7 @@ double CchMetric::settle(std::uint32_t arc, bool upward, std::vector<std::uint32
   // witness to another triangle of lower-bound sum; sums only rise as witnesses settle, so the
   // rounds end.
   std::uint32_t& exact = upward ? exact_up_[arc] : exact_down_[arc];
-  if (exact >= changed_below_[t.tail(arc)]) return upward ? up_[arc] : down_[arc];
+  if (known_exact(arc, upward)) return upward ? up_[arc] : down_[arc];
   for (;;) {
     const std::uint32_t z = upward ? via_up_[arc] : via_down_[arc];
     double witnessed = kInfCost;
@@ -387,7 +392,7 @@ double CchMetric::settle(std::uint32_t arc, bool upward, std::vector<std::uint32
       witnessed = input_cost(arc, upward);
     } else {
       // x→z→y upward, y→z→x downward, z below both (as unpack follows them).
-      const std::uint32_t zx = t.find_arc(z, t.tail(arc)), zy = t.find_arc(z, t.head(arc));
+      const auto [zx, zy] = t.find_arcs_up(z, t.tail(arc), t.head(arc));
       witnessed = upward ? add_cost(settle(zx, false, raised), settle(zy, true, raised))
                          : add_cost(settle(zy, false, raised), settle(zx, true, raised));
     }
@@ -422,6 +427,27 @@ std::string CchMetric::invariant_violation() const {
       if (up_[arc] > up || down_[arc] > down) {
         return "arc " + std::to_string(arc) + " holds " + std::to_string(up_[arc]) + "/" + std::to_string(down_[arc]) +
                " above what its triangles give, " + std::to_string(up) + "/" + std::to_string(down);
+      }
+      // A weight settle() would take as exact without looking is its witness's sum, over sides
+      // it would take as exact too: so, by induction, the cost of the path it unpacks to.
+      for (const bool upward : {true, false}) {
+        if (!known_exact(arc, upward)) continue;
+        const double w = upward ? up_[arc] : down_[arc];
+        const std::uint32_t z = upward ? via_up_[arc] : via_down_[arc];
+        double witnessed = input_cost(arc, upward);
+        if (z != kNoCchArc) {
+          const auto [zx, zy] = t.find_arcs_up(z, t.tail(arc), t.head(arc));
+          if (zx == kNoCchArc || zy == kNoCchArc) return "arc " + std::to_string(arc) + "'s witness is not a triangle";
+          if (!known_exact(zx, !upward) || !known_exact(zy, upward)) {
+            return "arc " + std::to_string(arc) + (upward ? " up" : " down") +
+                   " is taken as exact over a side that is not";
+          }
+          witnessed = upward ? add_cost(down_[zx], up_[zy]) : add_cost(down_[zy], up_[zx]);
+        }
+        if (witnessed != w) {
+          return "arc " + std::to_string(arc) + (upward ? " up" : " down") + " is taken as exact at " +
+                 std::to_string(w) + " but its witness gives " + std::to_string(witnessed);
+        }
       }
       continue;
     }

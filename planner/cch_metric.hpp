@@ -80,13 +80,14 @@ class CchMetric {
 
   // Makes arc `arc`'s weight in one direction exact, and returns it: the witnesses it unpacks
   // through are settled first, bottom up, and a weight below the cost of its witness's path under
-  // today's inputs is re-derived from its triangles until the two agree. A lower bound that agrees
-  // with the cost of a real path is the cheapest. Appends the arcs whose weight it raised to
-  // `raised`. Does nothing on an eager metric, whose weights are always exact.
+  // the inputs as last reported is re-derived from its triangles until the two agree. A lower
+  // bound that agrees with the cost of a real path is the cheapest. Appends the arcs whose weight
+  // it raised to `raised`. Does nothing on an eager metric, whose weights are always exact.
   double settle(std::uint32_t arc, bool upward, std::vector<std::uint32_t>& raised);
 
   // Checks every arc against its lower triangles and its input (lazy rises: that it lies at or
-  // below them); for tests. Empty when all hold.
+  // below them, that the kept input costs are today's, and that a weight settle() would return
+  // without looking is the cost of the path it unpacks to); for tests. Empty when all hold.
   [[nodiscard]] std::string invariant_violation() const;
 
   [[nodiscard]] std::size_t memory_bytes() const;
@@ -173,6 +174,10 @@ class CchMetric {
     return input == kNoCchArc ? kInfCost : input_s(input);
   }
   void mark_changed(std::uint32_t arc);
+  // Whether settle() may return arc `arc`'s weight in that direction without looking.
+  [[nodiscard]] bool known_exact(std::uint32_t arc, bool upward) const {
+    return (upward ? exact_up_[arc] : exact_down_[arc]) >= changed_below_[topology_->tail(arc)];
+  }
   const void* settler_ = nullptr;
 };
 
