@@ -308,9 +308,9 @@ CustomizationStats CchMetric::propagate(std::vector<std::uint32_t>& changed) {
     changed.push_back(arc);
     if (options_.lazy_rises) {
       // A lower bound that a fall moved (down) is not known to be exact: settle() must look. One
-      // that did not move is exact still: it lies at or below today's cost, which a fall cannot
-      // have raised above the cost it was found exact at. So a fall marks only the weights it
-      // moves, where a rise marks its whole subtree.
+      // that did not move is exact still: it lies at or below today's cost, and a fall can only
+      // have lowered that cost from the one it was found exact at, which is the weight itself.
+      // So a fall marks only the weights it moves, where a rise marks its whole subtree.
       if (up_moved) exact_up_[arc] = 0;
       if (down_moved) exact_down_[arc] = 0;
     }
