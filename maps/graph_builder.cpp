@@ -1,8 +1,8 @@
 #include "maps/graph_builder.hpp"
 
 #include <algorithm>
-#include <stdexcept>
 #include <numeric>
+#include <stdexcept>
 
 #include "maps/errors.hpp"
 #include "maps/strongly_connected.hpp"

@@ -95,6 +95,11 @@ void validate(const RoadGraphData& d) {
 
 }  // namespace
 
+bool continues_way_at_stop(const RoadGraphData& d, EdgeId in, EdgeId out) {
+  return !d.node_stop.empty() && d.node_stop[d.edge_head[in.index()].index()] != 0 && out != d.edge_twin[in.index()] &&
+         d.edge_osm_way[out.index()] == d.edge_osm_way[in.index()];
+}
+
 void build_reverse_adjacency(RoadGraphData& d) {
   const std::size_t n = d.node_x_m.size();
   d.first_in.assign(n + 1, 0);

@@ -83,6 +83,12 @@ struct RoadGraphData {
   std::vector<std::uint8_t> left_hand_traffic;
 };
 
+// Whether going from edge `in` onto edge `out`, at in's head, goes on along the same way through a
+// barrier the vehicle stops at (RoadGraphData::node_stop), not back. Such a node is a node only to
+// charge the barrier's delay: no turn is made there, whatever the bend. The turn graph gives the
+// move no angle and the route's steps no maneuver.
+bool continues_way_at_stop(const RoadGraphData& data, EdgeId in, EdgeId out);
+
 class RoadGraph {
  public:
   // Throws MapError when the arrays are inconsistent (for example, a corrupt cache).
@@ -156,6 +162,7 @@ class RoadGraph {
   // Whether a barrier the vehicle stops at (a gate, a toll booth) stands on node v.
   [[nodiscard]] bool has_stops() const { return !data_.node_stop.empty(); }
   [[nodiscard]] bool stop_at(NodeId v) const { return has_stops() && data_.node_stop[v.index()] != 0; }
+  [[nodiscard]] bool continues_way_at_stop(EdgeId in, EdgeId out) const { return maps::continues_way_at_stop(data_, in, out); }
   [[nodiscard]] bool on_roundabout(EdgeId e) const {
     return std::binary_search(data_.roundabout_edges.begin(), data_.roundabout_edges.end(), e);
   }

@@ -73,14 +73,13 @@ TurnGraph::TurnGraph(const RoadGraphData& d) : edge_count_(d.edge_head.size()) {
     const EdgeId twin = d.edge_twin[e];
     bool dead_end = true;
     for (auto f = d.first_out[n]; f < d.first_out[n + 1]; ++f) dead_end = dead_end && EdgeId{f} == twin;
-    // A gate inside a way (RoadGraphData::node_stop) is a node only to charge its delay: going on
-    // along the same way there is no turn, whatever the bend.
-    const bool at_stop = !d.node_stop.empty() && d.node_stop[n] != 0;
     for (auto f = d.first_out[n]; f < d.first_out[n + 1]; ++f) {
       Arc a{f, 0, 0, 0};
       if (!turns_in_edges) {
-        const bool along_the_way = at_stop && EdgeId{f} != twin && d.edge_osm_way[f] == d.edge_osm_way[e];
-        a.angle_deg = along_the_way ? std::int16_t{0} : static_cast<std::int16_t>(std::lround(signed_turn_deg(arriving[e], leaving[f])));
+        // A gate inside a way is no turn, whatever the bend (continues_way_at_stop).
+        a.angle_deg = continues_way_at_stop(d, EdgeId{static_cast<std::uint32_t>(e)}, EdgeId{f})
+                          ? std::int16_t{0}
+                          : static_cast<std::int16_t>(std::lround(signed_turn_deg(arriving[e], leaving[f])));
         if (EdgeId{f} == twin) {
           a.bits = static_cast<std::uint16_t>(TurnArc::kTurnUturnBit | (dead_end ? TurnArc::kTurnDeadEndBit : 0));
         }

@@ -134,8 +134,7 @@ std::vector<RouteStep> route_steps(const maps::RoadGraph& g, const Route& route,
         const double turn = turn_between(g, in, out);
         const bool renamed = g.name(in) != g.name(out) || g.ref(in) != g.ref(out);
         // A bend at a gate inside one way is no maneuver: the gate is a node only for its delay.
-        const bool along_way_at_gate = g.stop_at(g.tail(out)) && g.osm_way(in) == g.osm_way(out);
-        const bool sharp = std::abs(turn) >= options.continue_turn_deg && !along_way_at_gate;
+        const bool sharp = std::abs(turn) >= options.continue_turn_deg && !g.continues_way_at_stop(in, out);
         if (renamed || sharp || boards_or_leaves) {
           RouteStep s;
           s.name = g.name(out);

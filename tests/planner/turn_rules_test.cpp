@@ -477,6 +477,26 @@ TEST(TurnRules, AGateOnABendIsNoTurn) {
   EXPECT_EQ(names, (std::vector<std::string>{"West", "Bend Road", "North", "North"}));
 }
 
+// Turning back at a gate that closes a dead end is a U-turn all the same: the gate takes away only
+// the bends along its way, not the turn back.
+TEST(TurnRules, AUturnAtADeadEndGateIsAStep) {
+  maps::testing::TempDir dir;
+  const auto file = dir.path() / "lane.osm";
+  maps::testing::write_osm(file, {at(0, -100, 0), at(1, 0, 0), at(2, 100, 0, Tags{{"barrier", "gate"}})},
+                           {{60, {0, 1}, Tags{{"highway", "residential"}, {"name", "West"}}},
+                            {70, {1, 2}, Tags{{"highway", "residential"}, {"name", "Gate Lane"}}}},
+                           {});
+  maps::OsmImportOptions options;
+  options.show_progress = false;
+  const auto g = maps::import_osm(file, options);
+  ASSERT_EQ(g.stop_at(g.head(edge(g, 1, 2))), true);
+  const Trip back = drive(g, ambulance_profile(), {{edge(g, 1, 2), 50.0}}, {{edge(g, 2, 1), 80.0}});
+  ASSERT_TRUE(back.route.found);
+  ASSERT_EQ(back.route.edges, (std::vector<EdgeId>{edge(g, 1, 2), edge(g, 2, 1)}));
+  const auto steps = route_steps(g, back.route);
+  EXPECT_TRUE(std::any_of(steps.begin(), steps.end(), [](const RouteStep& st) { return st.modifier == TurnModifier::uturn; }));
+}
+
 // A trip that starts or ends within a metre of a junction starts or ends at it: no step of 0.3 m on
 // the street it leaves (or reaches) at once. Two metres is a real step and stays.
 TEST(TurnRules, AStepShorterThanAMetreAtEitherEndIsFoldedIntoItsNeighbour) {
