@@ -71,17 +71,6 @@ SnapResult EdgeSnapper::snap(LatLon p, const SnapOptions& options) const {
   }
 }
 
-namespace {
-
-// The nearest point to p on segment ab, as the fraction t along it.
-double project(Point2 p, Point2 a, Point2 b) {
-  const double dx = b.x_m - a.x_m, dy = b.y_m - a.y_m;
-  const double len2 = dx * dx + dy * dy;
-  return len2 > 0.0 ? std::clamp(((p.x_m - a.x_m) * dx + (p.y_m - a.y_m) * dy) / len2, 0.0, 1.0) : 0.0;
-}
-
-}  // namespace
-
 std::vector<SnapResult> EdgeSnapper::candidates_local(Point2 p, double radius_m, std::size_t max_count) const {
   std::vector<SnapResult> out;
   if (!std::isfinite(p.x_m) || !std::isfinite(p.y_m) || !(radius_m > 0.0) || max_count == 0) return out;
@@ -93,7 +82,7 @@ std::vector<SnapResult> EdgeSnapper::candidates_local(Point2 p, double radius_m,
     const auto& piece = index_->pieces[piece_id];
     const Point2 a{bg::get<0, 0>(segment), bg::get<0, 1>(segment)};
     const Point2 b{bg::get<1, 0>(segment), bg::get<1, 1>(segment)};
-    const double t = project(p, a, b);
+    const double t = segment_fraction(p, a, b);
     const Point2 q{a.x_m + t * (b.x_m - a.x_m), a.y_m + t * (b.y_m - a.y_m)};
     const double d = distance_m(p, q);
     if (d > radius_m) continue;

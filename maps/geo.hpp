@@ -29,6 +29,15 @@ inline double distance_m(Point2 a, Point2 b) {
   return std::sqrt(dx * dx + dy * dy);
 }
 
+// The nearest point to p on segment ab, as the fraction along it (0 at a, 1 at b).
+inline double segment_fraction(Point2 p, Point2 a, Point2 b) {
+  const double dx = b.x_m - a.x_m, dy = b.y_m - a.y_m;
+  const double len2 = dx * dx + dy * dy;
+  if (!(len2 > 0.0)) return 0.0;
+  const double t = ((p.x_m - a.x_m) * dx + (p.y_m - a.y_m) * dy) / len2;
+  return t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
+}
+
 // True when the coordinate is finite and inside WGS84 bounds.
 bool is_valid_lat_lon(LatLon p);
 

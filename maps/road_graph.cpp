@@ -156,4 +156,27 @@ Point2 RoadGraph::point_along(EdgeId e, double offset_m) const {
   return pts.back();
 }
 
+RoadGraph::EdgePoint RoadGraph::nearest_point(EdgeId e, Point2 p) const {
+  const auto pts = geometry(e);
+  EdgePoint best;
+  best.point = pts.front();
+  best.distance_m = distance_m(p, pts.front());
+  double along = 0.0, best_along = 0.0;
+  for (std::size_t i = 1; i < pts.size(); ++i) {
+    const double seg = distance_m(pts[i - 1], pts[i]);
+    const double t = segment_fraction(p, pts[i - 1], pts[i]);
+    const Point2 q{pts[i - 1].x_m + t * (pts[i].x_m - pts[i - 1].x_m), pts[i - 1].y_m + t * (pts[i].y_m - pts[i - 1].y_m)};
+    const double d = distance_m(p, q);
+    if (d < best.distance_m) {
+      best.point = q;
+      best.distance_m = d;
+      best_along = along + t * seg;
+    }
+    along += seg;
+  }
+  // Offsets are in units of the edge's stated length (point_along's rule).
+  best.offset_m = along > 0.0 ? std::clamp(best_along * length_m(e) / along, 0.0, length_m(e)) : 0.0;
+  return best;
+}
+
 }  // namespace corridor::maps

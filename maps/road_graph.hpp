@@ -138,6 +138,14 @@ class RoadGraph {
 
   // The point at `offset_m` along edge e (clamped to the edge).
   [[nodiscard]] Point2 point_along(EdgeId e, double offset_m) const;
+  // The nearest point of edge e to p: its offset (in the edge's length units, as point_along
+  // takes it), the point, and its distance from p.
+  struct EdgePoint {
+    double offset_m = 0.0;
+    Point2 point;
+    double distance_m = 0.0;
+  };
+  [[nodiscard]] EdgePoint nearest_point(EdgeId e, Point2 p) const;
 
   [[nodiscard]] const LocalProjection& projection() const { return projection_; }
   [[nodiscard]] const RoadGraphData& data() const { return data_; }

@@ -52,6 +52,24 @@ TEST(EdgeSnapper, NearestPointMatchesBruteForce) {
   }
 }
 
+// One edge's nearest point agrees with the snapper's wherever the snapper picks that edge: same
+// distance, and an offset that lands on the point.
+TEST(RoadGraph, NearestPointOfAnEdgeAgreesWithTheSnapper) {
+  const RoadGraph g = grid();
+  const EdgeSnapper snapper(g);
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> x(g.min_corner().x_m, g.max_corner().x_m);
+  std::uniform_real_distribution<double> y(g.min_corner().y_m, g.max_corner().y_m);
+  for (int i = 0; i < 300; ++i) {
+    const Point2 p{x(rng), y(rng)};
+    const SnapResult r = snapper.snap_local(p, {1e6});
+    const RoadGraph::EdgePoint q = g.nearest_point(r.edge, p);
+    EXPECT_NEAR(q.distance_m, r.distance_m, 1e-6);
+    EXPECT_NEAR(q.offset_m, r.offset_m, 1e-6);
+    EXPECT_NEAR(distance_m(g.point_along(r.edge, q.offset_m), q.point), 0.0, 1e-6);
+  }
+}
+
 // The two directions of a road may differ in length (a SUMO net's lanes do): the twin's offset is
 // the same share of the way from the other end, both ends included.
 TEST(RoadGraph, TwinOffsetIsTheSameShareFromTheOtherEnd) {
