@@ -59,5 +59,78 @@ TEST(PathSmoother, AveragesAlongThePathWithTheSpeeds) {
   EXPECT_NEAR(out[25].offset_m, 350.0, 1.0);
 }
 
+// A road west to east through node B (300, 0), with a one-way loop of 88 m off B (a small
+// roundabout): B → P → Q → B.
+struct LoopDrive {
+  maps::RoadGraph g = [] {
+    Sketch s;
+    s.nodes = {{0, 0}, {300, 0}, {700, 0}, {315, 25}, {285, 25}};
+    s.roads = {{{0, 1, 2}, false, 1}, {{1, 3, 4, 1}, true, 2}};
+    return s.build();
+  }();
+  planner::BoundedDistances distances{g.node_count()};
+  std::vector<GpsFix> fixes;
+  std::vector<MatchedPoint> points;
+
+  EdgeId edge(maps::Point2 from, maps::Point2 to) const {
+    for (EdgeId e : g.edges()) {
+      if (maps::distance_m(g.position(g.tail(e)), from) < 0.5 && maps::distance_m(g.position(g.head(e)), to) < 0.5) return e;
+    }
+    return EdgeId{};
+  }
+  const EdgeId ab = edge({0, 0}, {300, 0}), bc = edge({300, 0}, {700, 0});
+  const EdgeId bp = edge({300, 0}, {315, 25}), qb = edge({285, 25}, {300, 0});
+
+  // A fix a second at `speed`, its position and its match at `offset` along `e`.
+  void add(EdgeId e, double offset, double speed) {
+    const maps::Point2 p = g.point_along(e, offset);
+    fixes.push_back({static_cast<double>(fixes.size()), g.projection().to_lat_lon(p), 1.0, std::nullopt, speed});
+    MatchedPoint m;
+    m.matched = true;
+    m.edge = e;
+    m.offset_m = offset;
+    m.point = p;
+    points.push_back(m);
+  }
+};
+
+// Fixes scattered over a small roundabout can make the most likely path run once round it. The
+// speeds say the vehicle drove 10 m a second straight through: the loop is taken out, the two fixes
+// on it go onto the road, and the points after it are not pulled 88 m back along the path.
+TEST(PathSmoother, TakesOutALoopTheSpeedsSayWasNotDriven) {
+  LoopDrive d;
+  ASSERT_TRUE(d.ab.valid() && d.bc.valid() && d.bp.valid() && d.qb.valid());
+  for (int i = 0; i < 20; ++i) d.add(d.ab, 100.0 + 10.0 * i, 10.0);  // x = 100 … 290
+  d.add(d.bp, 5.0, 10.0);   // two fixes noise put on the loop, at x = 300 and 310
+  d.add(d.qb, 25.0, 10.0);
+  for (int i = 2; i < 20; ++i) d.add(d.bc, 10.0 * i, 10.0);           // x = 320 … 490
+  const auto out = smooth_along_path(d.g, d.distances, d.fixes, d.points);
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    ASSERT_TRUE(out[i].matched) << i;
+    EXPECT_TRUE(out[i].edge == d.ab || out[i].edge == d.bc) << "fix " << i << " left on the loop";
+    const double x = 100.0 + 10.0 * static_cast<double>(i);
+    EXPECT_NEAR(out[i].point.x_m, x, 4.0) << i;
+  }
+}
+
+// A vehicle that does drive round the loop (its speeds cover the 88 m) keeps it.
+TEST(PathSmoother, KeepsALoopTheSpeedsSayWasDriven) {
+  LoopDrive d;
+  for (int i = 0; i < 20; ++i) d.add(d.ab, 100.0 + 10.0 * i, 10.0);  // x = 100 … 290
+  const EdgeId loop[] = {d.bp, d.edge({315, 25}, {285, 25}), d.qb};
+  const double round = d.g.length_m(loop[0]) + d.g.length_m(loop[1]) + d.g.length_m(loop[2]);
+  for (double along = 0.0; along < round; along += 10.0) {  // round it at 10 m/s
+    std::size_t k = 0;
+    double offset = along;
+    while (k < 2 && offset > d.g.length_m(loop[k])) offset -= d.g.length_m(loop[k++]);
+    d.add(loop[k], offset, 10.0);
+  }
+  for (int i = 0; i < 15; ++i) d.add(d.bc, 5.0 + 10.0 * i, 10.0);
+  const auto out = smooth_along_path(d.g, d.distances, d.fixes, d.points);
+  std::size_t on_loop = 0;
+  for (const MatchedPoint& m : out) on_loop += m.edge == loop[0] || m.edge == loop[1] || m.edge == loop[2] ? 1 : 0;
+  EXPECT_GE(on_loop, 7u);
+}
+
 }  // namespace
 }  // namespace corridor::localizer
