@@ -202,6 +202,7 @@ def run_sumo(args, tools, net, route_files, probe_ids, env):
     sumo_log = os.path.join(args.out, "sumo.log")
     cmd = ["sumo", "-n", net, "-r", ",".join(route_files),
            "--begin", "0", "--end", f"{args.end_s:g}", "--step-length", "1", "--seed", str(args.seed),
+           "--step-method.ballistic", "true" if args.step_method == "ballistic" else "false",
            "--fcd-output", fcd, "--fcd-output.geo", "true", "--device.fcd.explicit", ",".join(probe_ids),
            "--tripinfo-output", tripinfo, "--tripinfo-output.write-unfinished", "true",
            "--no-step-log", "true", "--ignore-route-errors", "true", "--duration-log.statistics", "true",
@@ -378,6 +379,14 @@ def main():
                     help="background departures continue this long after the last probe departs (s)")
     ap.add_argument("--end-s", type=float, default=3600.0, help="simulation end time (s)")
     ap.add_argument("--rebuild", action="store_true", help="rebuild the net even if it is up to date")
+    # SUMO's default (Euler) update moves a vehicle by its end-of-step speed over the whole step, so
+    # the speed written with a position is not the rate at which the positions change: a vehicle
+    # braking to a stop covers less ground than its speeds say, which puts a speed-aided smoother a
+    # few metres ahead of it at every stop. The ballistic update moves it by the mean of the two
+    # speeds, as a body with constant acceleration over the step moves, and a receiver's Doppler
+    # speed is that rate. docs/experiments/localization.md gives the figures with both.
+    ap.add_argument("--step-method", choices=("ballistic", "euler"), default="ballistic",
+                    help="SUMO's position update (default ballistic: positions integrate the speeds)")
     args = ap.parse_args()
 
     if args.drives < 1:

@@ -10,6 +10,7 @@
 #include <numbers>
 #include <random>
 #include <sstream>
+#include <unordered_set>
 
 namespace corridor::localizer {
 namespace {
@@ -65,6 +66,8 @@ std::vector<TrueEdges> true_edges(const maps::RoadGraph& g, const maps::EdgeSnap
                                   const std::vector<TruthSample>& samples, double radius_m) {
   std::vector<TrueEdges> out(samples.size());
   std::vector<std::uint8_t> in_junction(samples.size(), 0);
+  std::unordered_set<std::int64_t> graph_ways;
+  for (EdgeId e : g.edges()) graph_ways.insert(g.osm_way(e).v);
   for (std::size_t i = 0; i < samples.size(); ++i) {
     const TruthSample& s = samples[i];
     const maps::Point2 p = g.projection().to_local(s.position);
@@ -76,11 +79,15 @@ std::vector<TrueEdges> true_edges(const maps::RoadGraph& g, const maps::EdgeSnap
       in_junction[i] = 1;
       continue;
     }
+    const auto way = sumo_lane_osm_way(s.lane);
+    // A lane on a way the graph does not have (SUMO drives some ways our importer leaves out, such
+    // as a street closed to motor vehicles) is off our roads: no edge of the graph is the truth.
+    if (way && !graph_ways.contains(*way)) continue;
     out[i].edge = nearest;
     // ...unless the lane's way has an edge here: its nearest, if not well beyond that road.
     // netconvert joins consecutive ways into one edge (--geometry.remove), and its lane then
     // names only the way where that edge starts.
-    if (const auto way = sumo_lane_osm_way(s.lane)) {
+    if (way) {
       const auto on_way = nearest_agreeing(g, candidates, s.heading_deg, 90.0, nearest_d + 4.0,
                                            [&](EdgeId e) { return g.osm_way(e).v == *way; });
       if (on_way.first.valid()) out[i].edge = on_way.first, out[i].from_lane = true;

@@ -99,8 +99,9 @@ struct TrueEdges {
 // The true edges of a drive. A sample on a lane of OSM way W: the nearest edge of W whose
 // direction agrees with the heading within 90°, so a parallel road or a lane offset cannot fool
 // it, if it lies within 4 m more than true_edge()'s road (else SUMO's edge spans ways, and that
-// road stands); inside a junction: the edges before and after it and, where SUMO joined several
-// OSM nodes into one junction, the short OSM edges between them; otherwise true_edge().
+// road stands); none if the graph has no edge of W (the vehicle is off our roads); inside a
+// junction: the edges before and after it and, where SUMO joined several OSM nodes into one
+// junction, the short OSM edges between them; otherwise true_edge().
 std::vector<TrueEdges> true_edges(const maps::RoadGraph& graph, const maps::EdgeSnapper& snapper,
                                   const std::vector<TruthSample>& samples, double radius_m);
 

@@ -504,6 +504,21 @@ TEST(LocalizationStudy, TrueEdgesFollowTheLaneWayAndSpanAJunction) {
   EXPECT_EQ(truth[3].edge, edge_between(g, {-300, 4}, {-10, 4}));  // no lane: the nearest road
 }
 
+// SUMO drives some ways our importer leaves out (a street closed to motor vehicles): a sample on
+// such a way's lane has no true edge, though one of our roads runs 4 m from it.
+TEST(LocalizationStudy, ALaneOnAWayTheGraphLacksHasNoTrueEdge) {
+  Sketch s;
+  s.nodes = {{-300, 0}, {300, 0}};
+  s.roads = {{{0, 1}, false, 1}};
+  const auto g = s.build();
+  const maps::EdgeSnapper snapper(g);
+  const std::vector<TruthSample> drive = {eastward_sample(g, 0, 4, "7_0"), eastward_sample(g, 10, 4, "1_0")};
+  const auto truth = true_edges(g, snapper, drive, 20.0);
+  EXPECT_FALSE(truth[0].valid());
+  EXPECT_TRUE(truth[0].nearest.valid());  // the nearest road is still reported, for comparison
+  EXPECT_EQ(truth[1].edge, edge_between(g, {-300, 0}, {300, 0}));
+}
+
 // SUMO joins OSM nodes a few metres apart into one junction (a divided road's crossing): a vehicle
 // inside it may be on the short OSM edge between them, which is then part of the truth too; the
 // way back and a street leaving the junction are not.
