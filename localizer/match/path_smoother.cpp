@@ -33,11 +33,19 @@ double driven_m(std::span<const GpsFix> fixes, std::size_t a, std::size_t b) {
 // then spread it over the fixes on both sides (tens of metres along the road at σ 15 m). The
 // fixes' speeds tell: between the last matched point before the loop and the first after it the
 // vehicle drove `driven` metres, the path with the loop is `with` long and without it `with − L`;
-// the loop goes where `driven` is nearer the shorter. The points matched on the loop are put on the
-// nearer of the edges into and out of its node. Without speeds, the path is kept as matched.
-void erase_undriven_loops(const maps::RoadGraph& g, std::span<const GpsFix> fixes, std::vector<MatchedPoint>& points,
-                          std::vector<Occurrence>& path, std::vector<double>& s, std::vector<std::size_t>& occurrence) {
+// the loop goes where `driven` is nearer the shorter, and where every fix matched on it lies
+// within 3σ of the edge into or out of its node, which then takes it. A fix further off says the
+// vehicle was out there, whatever the speeds say. Without speeds, the path is kept as matched.
+void erase_undriven_loops(const maps::RoadGraph& g, std::span<const GpsFix> fixes, const SmootherConfig& config,
+                          std::vector<MatchedPoint>& points, std::vector<Occurrence>& path, std::vector<double>& s,
+                          std::vector<std::size_t>& occurrence) {
   const std::size_t n = points.size();
+  struct Move {
+    std::size_t point;
+    bool into;  // onto the edge into the loop's node, else the one out of it
+    maps::RoadGraph::EdgePoint at;
+  };
+  std::vector<Move> moves;
   std::size_t from = 1;
   while (true) {
     // The first loop at or after `from`: occurrences [j, k) leave node v and k starts from it again.
@@ -60,26 +68,33 @@ void erase_undriven_loops(const maps::RoadGraph& g, std::span<const GpsFix> fixe
     const double loop = path[k].s_start - path[j].s_start;
     const double driven = driven_m(fixes, a, b);
     if (!(driven < s[b] - s[a] - 0.5 * loop)) continue;
-    // Out with it: the points on it go to the nearer of the edges into and out of node v.
-    const std::size_t removed = k - j;
-    const double out_start = path[j].s_start;  // where the edge out of v starts once the loop is out
-    for (std::size_t i = 0; i < n; ++i) {
-      if (!points[i].matched || occurrence[i] < j) continue;
-      if (occurrence[i] >= k) {
-        occurrence[i] -= removed;
-        s[i] -= loop;
-        continue;
-      }
+    moves.clear();
+    bool near = true;
+    for (std::size_t i = a + 1; i < b && near; ++i) {
+      if (!points[i].matched) continue;
       const maps::Point2 raw = g.projection().to_local(fixes[i].position);
       const auto out = g.nearest_point(path[k].edge, raw);
       const auto in = j > 0 ? g.nearest_point(path[j - 1].edge, raw) : out;
       const bool into = j > 0 && in.distance_m < out.distance_m;
-      const auto& q = into ? in : out;
-      points[i].edge = path[into ? j - 1 : k].edge;
-      points[i].offset_m = q.offset_m;
-      points[i].point = q.point;
-      occurrence[i] = into ? j - 1 : j;
-      s[i] = (into ? path[j - 1].s_start : out_start) + q.offset_m;
+      moves.push_back({i, into, into ? in : out});
+      near = moves.back().at.distance_m <= 3.0 * usable_hdop(fixes[i], config.default_hdop) * config.sigma_base_m;
+    }
+    if (!near) continue;
+    // Out with it.
+    const std::size_t removed = k - j;
+    const double out_start = path[j].s_start;  // where the edge out of v starts once the loop is out
+    for (const Move& m : moves) {
+      MatchedPoint& p = points[m.point];
+      p.edge = path[m.into ? j - 1 : k].edge;
+      p.offset_m = m.at.offset_m;
+      p.point = m.at.point;
+      occurrence[m.point] = m.into ? j - 1 : j;
+      s[m.point] = (m.into ? path[j - 1].s_start : out_start) + m.at.offset_m;
+    }
+    for (std::size_t i = b; i < n; ++i) {
+      if (!points[i].matched) continue;
+      occurrence[i] -= removed;
+      s[i] -= loop;
     }
     for (std::size_t o = k; o < path.size(); ++o) path[o].s_start -= loop;
     path.erase(path.begin() + static_cast<std::ptrdiff_t>(j), path.begin() + static_cast<std::ptrdiff_t>(k));
@@ -124,7 +139,7 @@ std::vector<MatchedPoint> smooth_along_path(const maps::RoadGraph& g, planner::B
     }
     last = i;
   }
-  erase_undriven_loops(g, fixes, out, path, s, occurrence);
+  erase_undriven_loops(g, fixes, config, out, path, s, occurrence);
   // A path much longer than the fixes moved (a loop round a block where noise put a fix behind
   // the last one) would drag the estimate along it: the chain is smoothed in two parts there.
   last = 0;

@@ -113,6 +113,21 @@ TEST(PathSmoother, TakesOutALoopTheSpeedsSayWasNotDriven) {
   }
 }
 
+// Fixes far out on the loop say the vehicle was there, whatever its speeds say: two fixes on the
+// loop's far side, 25 m from the road (over 3σ at σ 4 m), keep it.
+TEST(PathSmoother, KeepsALoopItsFixesLieOutOn) {
+  LoopDrive d;
+  const EdgeId far_side = d.edge({315, 25}, {285, 25});
+  for (int i = 0; i < 20; ++i) d.add(d.ab, 100.0 + 10.0 * i, 10.0);
+  d.add(far_side, 10.0, 10.0);
+  d.add(far_side, 20.0, 10.0);
+  for (int i = 2; i < 20; ++i) d.add(d.bc, 10.0 * i, 10.0);
+  const auto out = smooth_along_path(d.g, d.distances, d.fixes, d.points);
+  std::size_t on_loop = 0;
+  for (const MatchedPoint& m : out) on_loop += m.edge == d.bp || m.edge == far_side || m.edge == d.qb ? 1 : 0;
+  EXPECT_GE(on_loop, 2u);
+}
+
 // A vehicle that does drive round the loop (its speeds cover the 88 m) keeps it.
 TEST(PathSmoother, KeepsALoopTheSpeedsSayWasDriven) {
   LoopDrive d;
