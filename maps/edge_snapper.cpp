@@ -140,8 +140,7 @@ SnapResult EdgeSnapper::snap_local(Point2 p, const SnapOptions& options) const {
   const Point2 a{bg::get<0, 0>(segment), bg::get<0, 1>(segment)};
   const Point2 b{bg::get<1, 0>(segment), bg::get<1, 1>(segment)};
   const double dx = b.x_m - a.x_m, dy = b.y_m - a.y_m;
-  const double len2 = dx * dx + dy * dy;
-  const double t = len2 > 0.0 ? std::clamp(((p.x_m - a.x_m) * dx + (p.y_m - a.y_m) * dy) / len2, 0.0, 1.0) : 0.0;
+  const double t = segment_fraction(p, a, b);
 
   SnapResult r;
   r.edge = piece.edge;
@@ -155,7 +154,7 @@ SnapResult EdgeSnapper::snap_local(Point2 p, const SnapOptions& options) const {
     throw SnapError(SnapError::Reason::too_far_from_road, msg.str());
   }
   const double geometric = index_->geometric_length_m[r.edge.index()];
-  const double along = piece.start_along_m + t * std::sqrt(len2);
+  const double along = piece.start_along_m + t * std::sqrt(dx * dx + dy * dy);
   const double length = graph_.length_m(r.edge);
   r.offset_m = geometric > 0.0 ? std::clamp(along * length / geometric, 0.0, length) : 0.0;
   r.twin = graph_.twin(r.edge);

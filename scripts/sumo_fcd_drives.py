@@ -347,6 +347,7 @@ def summarise(args, name, probe_ids, fcd, tripinfo, sumo_log, teleported):
         "fcd_format": "per <timestep time=s>: <vehicle id x=lon y=lat angle=deg(0=north, clockwise) "
                       "speed=m/s lane pos=m .../>",
         "step_length_s": 1.0,
+        "step_method": args.step_method,
         "seed": args.seed,
         "requested_drives": args.drives,
         "background_vehicles": args.background,

@@ -5,6 +5,8 @@
 // and speeds, and a Rauch–Tung–Striebel pass backwards (batch), then mapped back onto the path's
 // edges. This is what brings the error along the road down, and with it the wrong-edge choices
 // that a few metres of along-road error cause at junctions.
+// Before that, a loop in the matched path that the fixes' speeds say was not driven (fixes
+// scattered over a small roundabout) is taken out, and its fixes put on the road into or out of it.
 #pragma once
 
 #include <span>

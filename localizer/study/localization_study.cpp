@@ -248,9 +248,10 @@ StudyResult run_localization_study(const maps::RoadGraph& g, const maps::EdgeSna
       on_track[i] = fused_correct && maps::distance_m(fused[i].match.point, truth[i]) < 15.0 ? 1 : 0;
     }
     // Recovery: from the outage's end until the fusion is back on the true edge, near the truth.
+    // A sample off our roads (no true edge) says nothing either way.
     if (config.outage_s > 0.0) {
       for (std::size_t i = 0; i < samples.size(); ++i) {
-        if (samples[i].time_s < outage_end) continue;
+        if (samples[i].time_s < outage_end || !truths[i].valid()) continue;
         if (on_track[i] != 0) break;
         d.recovery_s = samples[i].time_s - outage_end + 1.0;
       }

@@ -4,6 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <optional>
+
 #include "tests/localizer/sketch_graph.hpp"
 
 namespace corridor::localizer {
@@ -81,10 +84,11 @@ struct LoopDrive {
   const EdgeId ab = edge({0, 0}, {300, 0}), bc = edge({300, 0}, {700, 0});
   const EdgeId bp = edge({300, 0}, {315, 25}), qb = edge({285, 25}, {300, 0});
 
-  // A fix a second at `speed`, its position and its match at `offset` along `e`.
-  void add(EdgeId e, double offset, double speed) {
+  // A fix a second at `speed` (none if NaN), its position and its match at `offset` along `e`.
+  void add(EdgeId e, double offset, double speed, double hdop = 1.0) {
     const maps::Point2 p = g.point_along(e, offset);
-    fixes.push_back({static_cast<double>(fixes.size()), g.projection().to_lat_lon(p), 1.0, std::nullopt, speed});
+    fixes.push_back({static_cast<double>(fixes.size()), g.projection().to_lat_lon(p), hdop, std::nullopt,
+                     std::isnan(speed) ? std::nullopt : std::optional<double>(speed)});
     MatchedPoint m;
     m.matched = true;
     m.edge = e;
@@ -128,7 +132,8 @@ TEST(PathSmoother, KeepsALoopItsFixesLieOutOn) {
   EXPECT_GE(on_loop, 2u);
 }
 
-// A vehicle that does drive round the loop (its speeds cover the 88 m) keeps it.
+// A vehicle that does drive round the loop (its speeds cover the 88 m) keeps it. Its fixes there
+// are poor (HDOP 3: 3σ is 36 m, more than the loop lies from the road), so the speeds alone decide.
 TEST(PathSmoother, KeepsALoopTheSpeedsSayWasDriven) {
   LoopDrive d;
   for (int i = 0; i < 20; ++i) d.add(d.ab, 100.0 + 10.0 * i, 10.0);  // x = 100 … 290
@@ -138,13 +143,28 @@ TEST(PathSmoother, KeepsALoopTheSpeedsSayWasDriven) {
     std::size_t k = 0;
     double offset = along;
     while (k < 2 && offset > d.g.length_m(loop[k])) offset -= d.g.length_m(loop[k++]);
-    d.add(loop[k], offset, 10.0);
+    d.add(loop[k], offset, 10.0, 3.0);
   }
   for (int i = 0; i < 15; ++i) d.add(d.bc, 5.0 + 10.0 * i, 10.0);
   const auto out = smooth_along_path(d.g, d.distances, d.fixes, d.points);
   std::size_t on_loop = 0;
   for (const MatchedPoint& m : out) on_loop += m.edge == loop[0] || m.edge == loop[1] || m.edge == loop[2] ? 1 : 0;
   EXPECT_GE(on_loop, 7u);
+}
+
+// Without speeds nothing says how far the vehicle drove: the loop stays as matched, even where its
+// fixes lie near the road.
+TEST(PathSmoother, KeepsALoopWithoutSpeeds) {
+  LoopDrive d;
+  const double none = std::nan("");
+  for (int i = 0; i < 20; ++i) d.add(d.ab, 100.0 + 10.0 * i, none);
+  d.add(d.bp, 5.0, none);
+  d.add(d.qb, 25.0, none);
+  for (int i = 2; i < 20; ++i) d.add(d.bc, 10.0 * i, none);
+  const auto out = smooth_along_path(d.g, d.distances, d.fixes, d.points);
+  std::size_t on_loop = 0;
+  for (const MatchedPoint& m : out) on_loop += m.edge == d.bp || m.edge == d.qb || m.edge == d.edge({315, 25}, {285, 25}) ? 1 : 0;
+  EXPECT_GE(on_loop, 1u);
 }
 
 }  // namespace

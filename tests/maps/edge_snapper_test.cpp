@@ -70,6 +70,20 @@ TEST(RoadGraph, NearestPointOfAnEdgeAgreesWithTheSnapper) {
   }
 }
 
+// Offsets are in the edge's stated length: an edge stated twice as long as it is drawn puts a
+// point a third of the way along its drawing at two thirds of its drawn length.
+TEST(RoadGraph, NearestPointOffsetIsInTheStatedLength) {
+  RoadGraphData d = grid().data();
+  const EdgeId e{7};
+  const double drawn = d.edge_length_m[e.index()];
+  d.edge_length_m[e.index()] = 2.0 * drawn;
+  const RoadGraph g(std::move(d));
+  const Point2 third = g.point_along(e, g.length_m(e) / 3);  // a third of the way along the drawing
+  const RoadGraph::EdgePoint q = g.nearest_point(e, third);
+  EXPECT_NEAR(q.distance_m, 0.0, 1e-6);
+  EXPECT_NEAR(q.offset_m, 2.0 * drawn / 3, 1e-6);
+}
+
 // The two directions of a road may differ in length (a SUMO net's lanes do): the twin's offset is
 // the same share of the way from the other end, both ends included.
 TEST(RoadGraph, TwinOffsetIsTheSameShareFromTheOtherEnd) {
