@@ -167,5 +167,47 @@ TEST(PathSmoother, KeepsALoopWithoutSpeeds) {
   EXPECT_GE(on_loop, 1u);
 }
 
+// The road from the west ends at (300, 0) and goes on at (320, 0); our graph joins the two ends
+// only by a detour 63 m long through (310, 30) (SUMO's vehicle drove a link our importer left
+// out). Four fixes span the gap in 3 s, two set aside; the path between them is 73 m, the speeds
+// say 30, and the rule on the fixes' spacing alone (2 × 30 + 30 m) lets it through. Split there,
+// neither side is dragged along the detour.
+TEST(PathSmoother, SplitsTheChainAtAMoveTheSpeedsSayWasADetour) {
+  const maps::RoadGraph g = [] {
+    Sketch s;
+    s.nodes = {{0, 0}, {300, 0}, {310, 30}, {320, 0}, {700, 0}};
+    s.roads = {{{0, 1}, true, 1}, {{1, 2, 3}, true, 2}, {{3, 4}, true, 3}};
+    return s.build();
+  }();
+  planner::BoundedDistances distances{g.node_count()};
+  auto edge = [&](maps::Point2 from) {
+    for (EdgeId e : g.edges()) {
+      if (maps::distance_m(g.position(g.tail(e)), from) < 0.5) return e;
+    }
+    return EdgeId{};
+  };
+  const EdgeId west = edge({0, 0}), east = edge({320, 0});
+  std::vector<GpsFix> fixes;
+  std::vector<MatchedPoint> points;
+  for (int i = 0; i < 40; ++i) {
+    const double x = 100.0 + 10.0 * i;  // x = 100 … 490, 10 m/s
+    fixes.push_back({static_cast<double>(i), g.projection().to_lat_lon({x, 0}), 1.0, 90.0, 10.0});
+    MatchedPoint m;
+    if (x <= 300.0 || x >= 330.0) {  // the two in the gap are set aside
+      m.matched = true;
+      m.edge = x <= 300.0 ? west : east;
+      m.offset_m = x <= 300.0 ? x : x - 320.0;
+      m.point = {x, 0};
+    }
+    points.push_back(m);
+  }
+  const auto out = smooth_along_path(g, distances, fixes, points);
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    if (!points[i].matched) continue;
+    EXPECT_NEAR(out[i].point.x_m, 100.0 + 10.0 * static_cast<double>(i), 3.0) << i;
+    EXPECT_NEAR(out[i].point.y_m, 0.0, 0.5) << i;
+  }
+}
+
 }  // namespace
 }  // namespace corridor::localizer
