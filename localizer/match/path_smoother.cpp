@@ -159,26 +159,25 @@ std::vector<MatchedPoint> smooth_along_path(const maps::RoadGraph& g, planner::B
   // NaN from driven_m (no speeds) compares false: only the first rule applies.
   auto sigma_of = [&](const GpsFix& f) { return usable_hdop(f, config.default_hdop) * config.sigma_base_m; };
   std::size_t before_last = 0;  // the matched point before `last`
-  std::size_t last_matched = n - 1;
-  while (last_matched > 0 && !points[last_matched].matched) --last_matched;
   last = 0;
   for (std::size_t i = 1; i < n; ++i) {
     if (!points[i].matched) continue;
     const double dt = std::max(1.0, fixes[i].time_s - fixes[last].time_s);
     const double moved = maps::distance_m(out[last].point, out[i].point);  // loops taken out
-    const double noise = 3.0 * std::sqrt(2.0) * std::max(sigma_of(fixes[last]), sigma_of(fixes[i])) + 10.0;
     // A move the speeds say the vehicle did not drive (the match went round a road our graph
     // lacks) splits it too, beyond what two noisy positions along the path allow, where the
     // points on either side agree among themselves: the point before `last` with it, the point
     // after `i` with `i`. One fix that far off alone is a multipath outlier, which the filter
-    // weighs down; so is a chain's first or last point, with nothing to agree with.
-    auto off = [&](std::size_t from, std::size_t to) {
-      return std::abs(s[to] - s[from] - driven_m(fixes, from, to)) > noise;
+    // weighs down; so is a chain's first or last point, with nothing to agree with. Both need the
+    // speeds: without them (NaN) two points neither disagree nor agree.
+    auto misfit = [&](std::size_t from, std::size_t to) {
+      const double noise = 3.0 * std::sqrt(2.0) * std::max(sigma_of(fixes[from]), sigma_of(fixes[to])) + 10.0;
+      return std::abs(s[to] - s[from] - driven_m(fixes, from, to)) - noise;  // > 0 off, ≤ 0 agree, NaN neither
     };
     std::size_t next = i + 1;
     while (next < n && !points[next].matched) ++next;
-    const bool detour = last > 0 && i < last_matched && off(last, i) && off(last, next) && !off(i, next) &&
-                        !off(before_last, last);
+    const bool detour = last > 0 && i + 1 < n && misfit(last, i) > 0.0 && misfit(last, next) > 0.0 &&
+                        misfit(i, next) <= 0.0 && misfit(before_last, last) <= 0.0;
     if (std::abs(s[i] - s[last]) > 2.0 * moved + 10.0 * dt || detour) {
       auto head = smooth_along_path(g, distances, fixes.first(last + 1), points.first(last + 1), config);
       const auto tail = smooth_along_path(g, distances, fixes.subspan(i), points.subspan(i), config);

@@ -62,6 +62,18 @@ TEST(PathSmoother, AveragesAlongThePathWithTheSpeeds) {
   EXPECT_NEAR(out[25].offset_m, 350.0, 1.0);
 }
 
+// The same outlier with the fix before it missing its speed: nothing says whether the fixes before
+// the outlier agree among themselves, so the outlier is not taken for the near side of a detour.
+TEST(PathSmoother, AnOutlierAfterAFixWithoutASpeedSplitsNothing) {
+  StraightDrive d;
+  d.points[15].offset_m += 40.0;
+  d.points[15].point.x_m += 40.0;
+  d.fixes[14].speed_mps.reset();
+  const auto out = smooth_along_path(d.g, d.distances, d.fixes, d.points);
+  EXPECT_NEAR(out[25].offset_m, 350.0, 1.0);
+  EXPECT_NEAR(out[5].offset_m, 150.0, 1.0);
+}
+
 // A road west to east through node B (300, 0), with a one-way loop of 88 m off B (a small
 // roundabout): B → P → Q → B.
 struct LoopDrive {
