@@ -6,7 +6,9 @@
 // edges. This is what brings the error along the road down, and with it the wrong-edge choices
 // that a few metres of along-road error cause at junctions.
 // Before that, a loop in the matched path that the fixes' speeds say was not driven (fixes
-// scattered over a small roundabout) is taken out, and its fixes put on the road into or out of it.
+// scattered over a small roundabout) is taken out, and its fixes put on the road into or out of it;
+// and the chain is smoothed in parts where the path between two points is far longer than the
+// fixes moved, or than the speeds say was driven (a detour round a road the graph lacks).
 #pragma once
 
 #include <span>
