@@ -4,6 +4,7 @@
 
 #include <limits>
 #include <random>
+#include <vector>
 
 #include "maps/errors.hpp"
 #include "maps/synthetic_grid.hpp"
@@ -34,14 +35,20 @@ double brute_force_distance(const RoadGraph& g, Point2 p) {
   return best;
 }
 
+// Points spread uniformly over the map's bounding box, the same ones for the same seed.
+std::vector<Point2> random_points(const RoadGraph& g, std::uint64_t seed, int count) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> x(g.min_corner().x_m, g.max_corner().x_m);
+  std::uniform_real_distribution<double> y(g.min_corner().y_m, g.max_corner().y_m);
+  std::vector<Point2> out;
+  for (int i = 0; i < count; ++i) out.push_back({x(rng), y(rng)});
+  return out;
+}
+
 TEST(EdgeSnapper, NearestPointMatchesBruteForce) {
   const RoadGraph g = grid();
   const EdgeSnapper snapper(g);
-  std::mt19937_64 rng(5);
-  std::uniform_real_distribution<double> x(g.min_corner().x_m, g.max_corner().x_m);
-  std::uniform_real_distribution<double> y(g.min_corner().y_m, g.max_corner().y_m);
-  for (int i = 0; i < 500; ++i) {
-    const Point2 p{x(rng), y(rng)};
+  for (const Point2 p : random_points(g, 5, 500)) {
     const SnapResult r = snapper.snap_local(p, {1e6});
     EXPECT_NEAR(r.distance_m, brute_force_distance(g, p), 1e-6);
     // The reported offset lands on the reported point.
@@ -57,11 +64,7 @@ TEST(EdgeSnapper, NearestPointMatchesBruteForce) {
 TEST(RoadGraph, NearestPointOfAnEdgeAgreesWithTheSnapper) {
   const RoadGraph g = grid();
   const EdgeSnapper snapper(g);
-  std::mt19937_64 rng(9);
-  std::uniform_real_distribution<double> x(g.min_corner().x_m, g.max_corner().x_m);
-  std::uniform_real_distribution<double> y(g.min_corner().y_m, g.max_corner().y_m);
-  for (int i = 0; i < 300; ++i) {
-    const Point2 p{x(rng), y(rng)};
+  for (const Point2 p : random_points(g, 9, 300)) {
     const SnapResult r = snapper.snap_local(p, {1e6});
     const RoadGraph::EdgePoint q = g.nearest_point(r.edge, p);
     EXPECT_NEAR(q.distance_m, r.distance_m, 1e-6);
