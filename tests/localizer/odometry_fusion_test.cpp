@@ -14,6 +14,7 @@ namespace corridor::localizer {
 namespace {
 
 using testing::Sketch;
+using testing::edge_between;
 
 // A crossroads at (0,0) with arms 300 m long to the north (1), east (2), south (3) and west (4).
 maps::RoadGraph crossroads() {
@@ -21,13 +22,6 @@ maps::RoadGraph crossroads() {
   s.nodes = {{0, 0}, {0, 300}, {300, 0}, {0, -300}, {-300, 0}};
   s.roads = {{{4, 0, 2}, false, 1}, {{1, 0, 3}, false, 2}};
   return s.build();
-}
-
-EdgeId edge_between(const maps::RoadGraph& g, maps::Point2 from, maps::Point2 to) {
-  for (EdgeId e : g.edges()) {
-    if (maps::distance_m(g.position(g.tail(e)), from) < 1.0 && maps::distance_m(g.position(g.head(e)), to) < 1.0) return e;
-  }
-  return EdgeId{};
 }
 
 // The localizer on the crossroads, for the tests of its GPS side.

@@ -13,6 +13,7 @@ namespace corridor::localizer {
 namespace {
 
 using testing::Sketch;
+using testing::edge_between;
 
 // A straight two-way road, 1 km, driven east at 10 m/s with a fix a second.
 struct StraightDrive {
@@ -87,12 +88,7 @@ struct LoopDrive {
   std::vector<GpsFix> fixes;
   std::vector<MatchedPoint> points;
 
-  EdgeId edge(maps::Point2 from, maps::Point2 to) const {
-    for (EdgeId e : g.edges()) {
-      if (maps::distance_m(g.position(g.tail(e)), from) < 0.5 && maps::distance_m(g.position(g.head(e)), to) < 0.5) return e;
-    }
-    return EdgeId{};
-  }
+  EdgeId edge(maps::Point2 from, maps::Point2 to) const { return edge_between(g, from, to); }
   const EdgeId ab = edge({0, 0}, {300, 0}), bc = edge({300, 0}, {700, 0});
   const EdgeId bp = edge({300, 0}, {315, 25}), qb = edge({285, 25}, {300, 0});
 
@@ -192,13 +188,7 @@ TEST(PathSmoother, SplitsTheChainAtAMoveTheSpeedsSayWasADetour) {
     return s.build();
   }();
   planner::BoundedDistances distances{g.node_count()};
-  auto edge = [&](maps::Point2 from) {
-    for (EdgeId e : g.edges()) {
-      if (maps::distance_m(g.position(g.tail(e)), from) < 0.5) return e;
-    }
-    return EdgeId{};
-  };
-  const EdgeId west = edge({0, 0}), east = edge({320, 0});
+  const EdgeId west = edge_between(g, {0, 0}, {300, 0}), east = edge_between(g, {320, 0}, {700, 0});
   std::vector<GpsFix> fixes;
   std::vector<MatchedPoint> points;
   for (int i = 0; i < 40; ++i) {

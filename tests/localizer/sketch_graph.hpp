@@ -46,4 +46,12 @@ struct Sketch {
   }
 };
 
+// The directed edge from the node at `from` to the node at `to` (within a metre), or invalid.
+inline EdgeId edge_between(const maps::RoadGraph& g, maps::Point2 from, maps::Point2 to) {
+  for (EdgeId e : g.edges()) {
+    if (maps::distance_m(g.position(g.tail(e)), from) < 1.0 && maps::distance_m(g.position(g.head(e)), to) < 1.0) return e;
+  }
+  return EdgeId{};
+}
+
 }  // namespace corridor::localizer::testing
