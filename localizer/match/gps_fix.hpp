@@ -31,7 +31,7 @@ struct MatchedPoint {
   maps::Point2 point;        // on the road, local frame
   double distance_m = 0;     // from the raw fix to `point`
   double confidence = 0;     // the chosen candidate's share of the step's probability, 0..1
-  bool chain_start = false;  // the first point after a break (gap, no candidate, impossible move)
+  bool chain_start = false;  // the first point after a break (gap, no candidate, impossible move, a restart)
   // Batch only: the fix, between two matched ones of its chain, was set aside as an outlier
   // (multipath). If `matched`, `point` is where the smoothed chain puts the vehicle at the fix's
   // time; without smoothing it stays unmatched. Fixes set aside at a chain's end, before a break,

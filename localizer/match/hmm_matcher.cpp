@@ -12,13 +12,14 @@ namespace corridor::localizer {
 namespace {
 
 constexpr double kNoScore = -std::numeric_limits<double>::infinity();
+constexpr std::int32_t kRestart = -2;  // a parent in Links: the path starts afresh there
 
 }  // namespace
 
 void HmmConfig::validate() const {
   if (!(sigma_base_m > 0.0) || !(default_hdop > 0.0) || !(beta_m > 0.0) || !(min_radius_m > 0.0) ||
-      !(max_radius_m >= min_radius_m) || !(max_speed_mps > 0.0) || !(gap_s > 0.0) || !(backward_tolerance_m >= 0.0) || !(backward_sigmas >= 0.0) ||
-      !(uturn_penalty >= 0.0) || !(outlier_penalty >= 0.0) || !(heading_sigma_deg > 0.0) ||
+      !(max_radius_m >= min_radius_m) || !(max_speed_mps > 0.0) || !(gap_s > 0.0) || !(speed_gap_s >= 0.0) || !(backward_tolerance_m >= 0.0) || !(backward_sigmas >= 0.0) ||
+      !(uturn_penalty >= 0.0) || !(outlier_penalty >= 0.0) || !(restart_penalty >= 0.0) || !(heading_sigma_deg > 0.0) ||
       !std::isfinite(heading_sigma_deg) || !(heading_wide_sigma_deg > 0.0) || !std::isfinite(heading_wide_sigma_deg) ||
       !(heading_wide_share >= 0.0 && heading_wide_share <= 1.0) ||
       max_candidates == 0 || window == 0 || max_skipped > 16) {
@@ -91,7 +92,7 @@ void HmmMatcher::relax(const Step& prev, const Step& next, const GpsFix& fix, do
   // No route can be longer than the fastest vehicle drives meanwhile; a generous detour budget
   // keeps the searches small where fixes are dense.
   const double bound = std::min(config_.max_speed_mps * std::max(dt, 1.0), 2.0 * straight + 300.0);
-  const bool use_speed = fix.speed_mps && std::isfinite(*fix.speed_mps) && dt > 0.0;
+  const bool use_speed = fix.speed_mps && std::isfinite(*fix.speed_mps) && dt > 0.0 && dt <= config_.speed_gap_s;
   // Both distances come from noisy fixes (projected onto the road, or straight between them), so
   // their difference spreads with the GPS noise: the scale grows with σ, never below beta_m.
   const double hdop = usable_hdop(fix, config_.default_hdop);
@@ -135,11 +136,26 @@ void HmmMatcher::relax(const Step& prev, const Step& next, const GpsFix& fix, do
   }
 }
 
+void HmmMatcher::allow_restarts(Links& links) const {
+  // Afresh, from the last step's best candidate (scored 0 on the scale of the last step), where
+  // that beats every way in; only once something links, so that a fix nothing reaches is still set
+  // aside or breaks the chain as before.
+  if (std::none_of(links.best.begin(), links.best.end(), [](double b) { return b != kNoScore; })) return;
+  for (std::size_t j = 0; j < links.best.size(); ++j) {
+    if (links.best[j] < -config_.restart_penalty) {
+      links.best[j] = -config_.restart_penalty;
+      links.parent[j] = kRestart;
+      links.back[j] = 1;
+    }
+  }
+}
+
 bool HmmMatcher::apply(Step& next, const Links& links, double base) {
   if (std::all_of(links.best.begin(), links.best.end(), [](double b) { return b == kNoScore; })) return false;
   for (std::size_t j = 0; j < next.candidates.size(); ++j) {
     Candidate& c = next.candidates[j];
-    c.parent = links.parent[j];
+    c.restart = links.parent[j] == kRestart;
+    c.parent = c.restart ? -1 : links.parent[j];
     c.back = links.back[j];
     c.score = links.best[j] == kNoScore ? kNoScore : c.score + links.best[j];
   }
@@ -155,6 +171,7 @@ bool HmmMatcher::apply(Step& next, const Links& links, double base) {
 bool HmmMatcher::link(const Step& prev, Step& next, const GpsFix& fix, planner::BoundedDistances& distances) {
   Links links(graph_, next.candidates);
   relax(prev, next, fix, 0.0, 1, prev.norm, distances, links);
+  allow_restarts(links);
   return apply(next, links, prev.norm);
 }
 
@@ -175,7 +192,7 @@ MatchedPoint HmmMatcher::point_of(const Step& step, std::size_t index) const {
   m.offset_m = c.offset_m;
   m.point = c.point;
   m.distance_m = c.distance_m;
-  m.chain_start = step.chain_start;
+  m.chain_start = step.chain_start || c.restart;
   double total = 0.0;
   for (const Candidate& o : step.candidates) {
     if (o.score != kNoScore) total += std::exp(o.score - c.score);
@@ -227,21 +244,9 @@ std::vector<MatchedPoint> HmmMatcher::match(std::span<const GpsFix> trace) {
   std::vector<MatchedPoint> out(trace.size());
   std::vector<Step> steps;
   std::vector<std::size_t> fix_of;  // steps[k] came from trace[fix_of[k]]
-  // Backtracks the chain steps[first..steps.size()) from its best last candidate; the fixes
-  // between its steps that the path leaves out are outliers.
-  auto finish_chain = [&](std::size_t first) {
-    if (steps.size() <= first) return;
-    std::size_t k = steps.size() - 1;
-    std::int32_t at = static_cast<std::int32_t>(best(steps[k]));
-    while (true) {
-      out[fix_of[k]] = point_of(steps[k], static_cast<std::size_t>(at));
-      if (k == first) break;
-      const Candidate& c = steps[k].candidates[static_cast<std::size_t>(at)];
-      if (c.parent < 0 || c.back > k - first) break;  // cannot happen inside a chain; stop rather than misread
-      k -= c.back;
-      at = c.parent;
-    }
-    const std::size_t from = fix_of[first], to = fix_of.back();
+  // Smooths the part of a chain from steps[first] to steps[last] (its points already set).
+  auto smooth_part = [&](std::size_t first, std::size_t last) {
+    const std::size_t from = fix_of[first], to = fix_of[last];
     for (std::size_t i = from; i <= to; ++i) out[i].outlier = !out[i].matched;
     if (config_.along_path != HmmConfig::AlongPath::smoothed) return;
     std::vector<MatchedPoint> chain_points(out.begin() + static_cast<std::ptrdiff_t>(from),
@@ -249,6 +254,7 @@ std::vector<MatchedPoint> HmmMatcher::match(std::span<const GpsFix> trace) {
     SmootherConfig smoother;
     smoother.sigma_base_m = config_.sigma_base_m;
     smoother.default_hdop = config_.default_hdop;
+    smoother.speed_gap_s = config_.speed_gap_s;
     const auto smoothed = smooth_along_path(graph_, distances, trace.subspan(from, to + 1 - from), chain_points, smoother);
     for (std::size_t i = from; i <= to; ++i) {
       MatchedPoint& m = out[i];
@@ -257,6 +263,32 @@ std::vector<MatchedPoint> HmmMatcher::match(std::span<const GpsFix> trace) {
       m.outlier = outlier;
       if (m.matched) m.distance_m = maps::distance_m(graph_.projection().to_local(trace[i].position), m.point);
     }
+  };
+  // Backtracks the chain steps[first..steps.size()) from its best last candidate; the fixes
+  // between its steps that the path leaves out are outliers. Where the path starts afresh
+  // (restart_penalty), the part before it ends at its own best candidate, and each part is
+  // smoothed alone.
+  auto finish_chain = [&](std::size_t first) {
+    if (steps.size() <= first) return;
+    std::size_t k = steps.size() - 1;
+    std::size_t part_last = k;
+    std::int32_t at = static_cast<std::int32_t>(best(steps[k]));
+    while (true) {
+      out[fix_of[k]] = point_of(steps[k], static_cast<std::size_t>(at));
+      if (k == first) break;
+      const Candidate& c = steps[k].candidates[static_cast<std::size_t>(at)];
+      if (c.restart) {
+        smooth_part(k, part_last);
+        for (std::size_t i = fix_of[k - 1] + 1; i < fix_of[k]; ++i) out[i].outlier = true;  // set aside between the parts
+        part_last = --k;
+        at = static_cast<std::int32_t>(best(steps[k]));
+        continue;
+      }
+      if (c.parent < 0 || c.back > k - first) break;  // cannot happen inside a chain; stop rather than misread
+      k -= c.back;
+      at = c.parent;
+    }
+    smooth_part(first, part_last);
   };
   std::size_t chain_first = 0;
   std::size_t skipped = 0;  // fixes in a row set aside because nothing in the chain reaches them
@@ -278,6 +310,7 @@ std::vector<MatchedPoint> HmmMatcher::match(std::span<const GpsFix> trace) {
         relax(steps[from], step, trace[i], static_cast<double>(back - 1) * config_.outlier_penalty,
               static_cast<std::uint8_t>(back), base, distances, links);
       }
+      allow_restarts(links);
       linked = apply(step, links, base);
     }
     // A fix nothing in the chain can reach, or with no road near, between fixes that fit it, is an

@@ -4,9 +4,10 @@
 // candidates (the planner's bounded one-to-many search) with the straight-line distance between
 // the fixes. Heading and speed, when a fix has them, weigh candidates and moves. Viterbi runs
 // incrementally, keeping a bounded window; a time gap, no candidate, or no possible move breaks
-// the chain, which restarts cleanly at the next fix. In batch, a few fixes in a row may instead be
-// set aside as outliers (max_skipped), where the fixes after them fit the chain; a time gap, or
-// more than that, still breaks it.
+// the chain, which restarts cleanly at the next fix, and a candidate that no move explains (the
+// vehicle drove where the map has no road) may start it afresh, at a price. In batch, a few fixes
+// in a row may instead be set aside as outliers (max_skipped), where the fixes after them fit the
+// chain; a time gap, or more than that, still breaks it.
 #pragma once
 
 #include <cstdint>
@@ -36,7 +37,12 @@ struct HmmConfig {
   double beta_m = 6.0;            // transition scale for |network − straight-line| (metres)...
   double beta_per_sigma = 0.7;    // ...at least this × the fix's σ
   double max_speed_mps = 70.0;    // a move needing more is impossible
-  double gap_s = 60.0;            // fixes further apart in time break the chain
+  // Fixes further apart in time break the chain. A GPS outage of a few minutes (a tunnel) is
+  // linked across: the route through it is checked against the straight line.
+  double gap_s = 180.0;
+  // One fix's speed × the time since the last fix measures the distance driven only over a few
+  // seconds; over a longer gap (a tunnel) the vehicle may have stopped or sped up meanwhile.
+  double speed_gap_s = 5.0;
   // The course over ground of a moving fix, against the road's bearing: a mixture of two
   // Gaussians. Along a road the course follows its bearing to within the receiver's course error,
   // a lane change and the road's drawing (heading_sigma_deg); through a junction's turn, or where
@@ -67,6 +73,15 @@ struct HmmConfig {
   // (unless along_path is projected, when they stay unmatched).
   std::size_t max_skipped = 2;
   double outlier_penalty = 6.0;
+  // A fix's candidate may also start the chain afresh, at this price (a log-likelihood), where every
+  // move into it from the last fix scores worse, or none reaches it while another candidate is
+  // reached. A vehicle on a road the map lacks (a street closed to traffic that it drives anyway,
+  // a car park) has fixes that no mapped move explains; without a way to start afresh, the chain
+  // stays on the roads that stay reachable, priced only by their emissions, and glues the matched
+  // path to a wrong road for as long as the vehicle is off the map. 40 is beyond any move a road
+  // explains (|route − driven| of about 40 β); the figures in docs/experiments/localization.md
+  // hold from 30 to 70. Infinite: never.
+  double restart_penalty = 40.0;
   // Batch: smooth each chain along its matched path (path_smoother.hpp), or leave each point
   // where its fix projects.
   enum class AlongPath { smoothed, projected } along_path = AlongPath::smoothed;
@@ -107,6 +122,7 @@ class HmmMatcher {
     double score;         // log probability of the best path ending here
     std::int32_t parent;  // index in the step `back` steps earlier, -1 at a chain start
     std::uint8_t back = 1;  // batch: more than 1 where the best path sets fixes aside as outliers
+    bool restart = false;   // the best path into it starts afresh here (restart_penalty)
   };
   struct Step {
     double time_s;
@@ -137,6 +153,9 @@ class HmmMatcher {
   // `base`.
   void relax(const Step& prev, const Step& next, const GpsFix& fix, double penalty, std::uint8_t back, double base,
              planner::BoundedDistances& distances, Links& links) const;
+  // Lets each candidate of `links` start afresh at restart_penalty where every move into it scores
+  // worse (scores on the scale of the last step's).
+  void allow_restarts(Links& links) const;
   // Gives `next` the scores and parents of `links` (on the scale of `base`); false (and `next`
   // untouched) when no candidate was reached.
   static bool apply(Step& next, const Links& links, double base);

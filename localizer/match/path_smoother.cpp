@@ -16,11 +16,14 @@ struct Occurrence {
 };
 
 // The distance the fixes' speeds say the vehicle drove from fix a to fix b (the trapezoid rule),
-// or NaN when a fix between them has no speed.
-double driven_m(std::span<const GpsFix> fixes, std::size_t a, std::size_t b) {
+// or NaN when a fix between them has no speed, or two of them lie more than speed_gap_s apart
+// (over a tunnel's minute, two speeds say nothing of where the vehicle stopped or sped up).
+double driven_m(std::span<const GpsFix> fixes, std::size_t a, std::size_t b, double speed_gap_s) {
   double sum = 0.0;
   for (std::size_t i = a; i < b; ++i) {
-    if (!fixes[i].speed_mps || !fixes[i + 1].speed_mps) return std::numeric_limits<double>::quiet_NaN();
+    if (!fixes[i].speed_mps || !fixes[i + 1].speed_mps || fixes[i + 1].time_s - fixes[i].time_s > speed_gap_s) {
+      return std::numeric_limits<double>::quiet_NaN();
+    }
     sum += 0.5 * (*fixes[i].speed_mps + *fixes[i + 1].speed_mps) * std::max(0.0, fixes[i + 1].time_s - fixes[i].time_s);
   }
   return sum;
@@ -77,7 +80,7 @@ void erase_undriven_loops(const maps::RoadGraph& g, std::span<const GpsFix> fixe
     }
     if (a == n || b == n) continue;  // so j ≥ 1: an edge leads into the loop's node
     const double loop = path[k].s_start - path[j].s_start;
-    const double driven = driven_m(fixes, a, b);
+    const double driven = driven_m(fixes, a, b, config.speed_gap_s);
     if (!(driven < s[b] - s[a] - 0.5 * loop)) continue;
     moves.clear();
     bool near = true;
@@ -172,7 +175,7 @@ std::vector<MatchedPoint> smooth_along_path(const maps::RoadGraph& g, planner::B
     // speeds: without them (NaN) two points neither disagree nor agree.
     auto misfit = [&](std::size_t from, std::size_t to) {
       const double noise = 3.0 * std::sqrt(2.0) * std::max(sigma_of(fixes[from]), sigma_of(fixes[to])) + 10.0;
-      return std::abs(s[to] - s[from] - driven_m(fixes, from, to)) - noise;  // > 0 off, ≤ 0 agree, NaN neither
+      return std::abs(s[to] - s[from] - driven_m(fixes, from, to, config.speed_gap_s)) - noise;  // > 0 off, ≤ 0 agree, NaN neither
     };
     std::size_t next = i + 1;
     while (next < n && !points[next].matched) ++next;

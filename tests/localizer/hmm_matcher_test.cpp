@@ -184,6 +184,66 @@ TEST(HmmMatcher, AGapOrNothingNearBreaksTheChainAndItRestarts) {
   EXPECT_FALSE(live[8].chain_start);
 }
 
+// A 90 s gap (a tunnel) between fixes on one road is no break: the move across it is checked
+// against the straight line, not against the one speed the fix after it reports. That fix was
+// taken standing in a queue; its speed × 90 s says 0 m were driven, where 860 m were.
+TEST(HmmMatcher, LinksAcrossAGapOfMinutesWithoutTrustingOneFixsSpeed) {
+  Sketch s;
+  s.nodes = {{0, 0}, {2000, 0}};
+  s.roads = {{{0, 1}, false, 1}};
+  const auto g = s.build();
+  const maps::EdgeSnapper snapper(g);
+  std::vector<GpsFix> trace;
+  for (int i = 0; i < 5; ++i) trace.push_back(fix_at(g, i, {100.0 + i * 10, 1.0}, 90.0, 10.0));
+  trace.push_back(fix_at(g, 94, {1000, 1.0}, 90.0, 0.0));
+  trace.push_back(fix_at(g, 95, {1000, 1.0}, 90.0, 0.0));
+  const auto m = HmmMatcher(g, snapper).match(trace);
+  ASSERT_TRUE(m[5].matched);
+  EXPECT_FALSE(m[5].chain_start);
+  HmmMatcher online(g, snapper);
+  std::vector<MatchedPoint> live;
+  for (const GpsFix& f : trace) live.push_back(online.update(f));
+  ASSERT_TRUE(live[5].matched);
+  EXPECT_FALSE(live[5].chain_start);
+  // A gap longer than gap_s still breaks the chain.
+  HmmConfig short_gap;
+  short_gap.gap_s = 60.0;
+  EXPECT_TRUE(HmmMatcher(g, snapper, short_gap).match(trace)[5].chain_start);
+}
+
+// The vehicle leaves the main road (way 1) by a link the map lacks, onto a road 20 m beside it
+// (way 2) that the map joins to the main road only 2 km further on. No move reaches way 2 from the
+// fixes before; the main road is reached, and each fix is only 20 m (3.3σ) from it. Without a
+// fresh start the chain stays glued to the main road for as long as the vehicle drives beside it.
+TEST(HmmMatcher, StartsAfreshWhereTheVehicleDroveOffTheMap) {
+  Sketch s;
+  s.nodes = {{0, 0}, {3000, 0}, {3000, 20}, {300, 20}};
+  s.roads = {{{0, 1}, false, 1}, {{1, 2, 3}, false, 2}};
+  const auto g = s.build();
+  const maps::EdgeSnapper snapper(g);
+  std::vector<GpsFix> trace;
+  for (int i = 0; i < 30; ++i) trace.push_back(fix_at(g, i, {10.0 * i, 0.5}, 90.0, 10.0));           // x = 0 … 290
+  for (int i = 0; i < 30; ++i) trace.push_back(fix_at(g, 31 + i, {310.0 + 10.0 * i, 20.5}, 90.0, 10.0));  // beside it
+  const auto m = HmmMatcher(g, snapper).match(trace);
+  for (std::size_t i = 0; i < 25; ++i) EXPECT_EQ(way_of(g, m[i]), 1) << i;
+  for (std::size_t i = 35; i < m.size(); ++i) EXPECT_EQ(way_of(g, m[i]), 2) << i;
+  bool restarted = false;
+  for (std::size_t i = 28; i < 36; ++i) restarted = restarted || m[i].chain_start;
+  EXPECT_TRUE(restarted);
+  HmmMatcher online(g, snapper);
+  std::vector<MatchedPoint> live;
+  for (const GpsFix& f : trace) live.push_back(online.update(f));
+  for (std::size_t i = 40; i < live.size(); ++i) EXPECT_EQ(way_of(g, live[i]), 2) << i;
+  // Never starting afresh, both stay on the main road.
+  HmmConfig never;
+  never.restart_penalty = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(way_of(g, HmmMatcher(g, snapper, never).match(trace).back()), 1);
+  HmmMatcher glued(g, snapper, never);
+  MatchedPoint last;
+  for (const GpsFix& f : trace) last = glued.update(f);
+  EXPECT_EQ(way_of(g, last), 1);
+}
+
 // A multipath fix lands on the top of a block beside the main road, where a drive round the block
 // could just reach it between two fixes. The path round it, less the price of one outlier, beats
 // the detour: the fix is set aside and placed on the main road where the vehicle was.

@@ -175,6 +175,29 @@ TEST(PathSmoother, KeepsALoopWithoutSpeeds) {
   EXPECT_GE(on_loop, 1u);
 }
 
+// A minute without fixes (a tunnel) between a fix at 10 m/s and a queue at its far end: the two
+// speeds' trapezoid says 310 m were driven where the path says 660. Over a gap that long the
+// speeds measure nothing, so this is no detour: the chain is smoothed whole, and the fix set
+// aside just before the gap is placed on the road (a split would leave it without an estimate).
+TEST(PathSmoother, ASpeedBeforeALongGapSaysNothingOfTheDistanceDriven) {
+  StraightDrive d;
+  d.fixes.resize(16);
+  d.points.resize(16);
+  d.points[15] = MatchedPoint{};  // x = 250, set aside
+  for (int i = 0; i < 5; ++i) {
+    const double x = 900.0;
+    d.fixes.push_back({75.0 + i, d.g.projection().to_lat_lon({x, 0}), 1.0, 90.0, 0.0});
+    MatchedPoint m = d.points[14];
+    m.offset_m = x;
+    m.point = {x, 0};
+    d.points.push_back(m);
+  }
+  const auto out = smooth_along_path(d.g, d.distances, d.fixes, d.points);
+  ASSERT_TRUE(out[15].matched);
+  EXPECT_NEAR(out[15].offset_m, 250.0, 5.0);
+  EXPECT_NEAR(out[20].offset_m, 900.0, 3.0);
+}
+
 // The road from the west ends at (300, 0) and goes on at (320, 0); our graph joins the two ends
 // only by a detour 63 m long through (310, 30) (SUMO's vehicle drove a link our importer left
 // out). Four fixes span the gap in 3 s, two set aside; the path between them is 73 m, the speeds
