@@ -33,7 +33,8 @@ std::pair<EdgeId, double> nearest_agreeing(const maps::RoadGraph& g, const std::
 constexpr auto kAnyEdge = [](EdgeId) { return true; };
 
 // The farthest apart that SUMO's junction joining puts OSM nodes of one junction
-// (netconvert --junctions.join-dist is 10 m; clusters chain a few of them).
+// (netconvert --junctions.join-dist is 10 m; clusters chain a few of them), beyond the distance
+// the vehicle drove through it.
 constexpr double kJunctionSpanM = 60.0;
 
 }  // namespace
@@ -109,7 +110,14 @@ std::vector<TrueEdges> true_edges(const maps::RoadGraph& g, const maps::EdgeSnap
     std::vector<EdgeId> through;
     if (before.valid() && after.valid() && before != after && g.head(before) != g.tail(after)) {
       const NodeId to = g.tail(after);
-      between.run(g, g.head(before), kJunctionSpanM, std::array<NodeId, 1>{to});
+      // A joined cluster on a fast road is crossed in several samples (Porto's span 80 m and more):
+      // the roads between may be as long as the vehicle drove from the sample before it to the one
+      // after.
+      double driven = 0.0;
+      for (std::size_t k = i > 0 ? i - 1 : i; k + 1 <= j && k + 1 < samples.size(); ++k) {
+        driven += maps::distance_m(g.projection().to_local(samples[k].position), g.projection().to_local(samples[k + 1].position));
+      }
+      between.run(g, g.head(before), kJunctionSpanM + driven, std::array<NodeId, 1>{to});
       through = between.path_to(g, to);
     }
     for (; i < j; ++i) {

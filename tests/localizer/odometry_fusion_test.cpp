@@ -533,6 +533,26 @@ TEST(LocalizationStudy, AJoinedJunctionCountsTheShortEdgesInsideIt) {
   EXPECT_FALSE(truth[0].contains(edge_between(g, {0, 0}, {8, 0})));    // outside it, one edge
 }
 
+// A joined cluster on a fast road can be longer than the fixed allowance (60 m): here 80 m, with
+// three OSM edges inside, crossed in three samples. The roads between may be as long as the
+// vehicle drove from the sample before the junction to the one after it.
+TEST(LocalizationStudy, ALongJoinedJunctionCountsEveryEdgeTheVehicleCrossed) {
+  Sketch s;
+  s.nodes = {{-300, 0}, {0, 0}, {40, 0}, {80, 0}, {400, 0}, {40, 100}};
+  s.roads = {{{0, 1}, false, 1}, {{1, 2}, false, 5}, {{2, 3}, false, 6}, {{3, 4}, false, 2}, {{2, 5}, false, 4}};
+  const auto g = s.build();
+  const maps::EdgeSnapper snapper(g);
+  auto sample = [&](double x, const char* lane) { return eastward_sample(g, x, 0, lane); };
+  const std::vector<TruthSample> drive = {sample(-30, "1_0"), sample(10, ":cluster_1_2_3_0_0"), sample(45, ":cluster_1_2_3_0_0"),
+                                          sample(75, ":cluster_1_2_3_0_0"), sample(110, "2_0")};
+  const auto truth = true_edges(g, snapper, drive, 20.0);
+  for (std::size_t i = 1; i <= 3; ++i) {
+    EXPECT_TRUE(truth[i].contains(edge_between(g, {0, 0}, {40, 0}))) << i;
+    EXPECT_TRUE(truth[i].contains(edge_between(g, {40, 0}, {80, 0}))) << i;
+    EXPECT_FALSE(truth[i].contains(edge_between(g, {40, 0}, {40, 100}))) << i;  // a street leaving it
+  }
+}
+
 // A drive that leaves our graph (SUMO keeps a way our importer drops): its samples there have no
 // true edge, and the on-graph RMSE leaves out the errors no matcher on our graph could avoid.
 TEST(LocalizationStudy, TheOnGraphRmseLeavesOutSamplesOffOurGraph) {
