@@ -19,13 +19,14 @@ constexpr std::int32_t kRestart = -2;  // a parent in Links: the path starts afr
 void HmmConfig::validate() const {
   if (!(sigma_base_m > 0.0) || !(default_hdop > 0.0) || !(beta_m > 0.0) || !(min_radius_m > 0.0) ||
       !(max_radius_m >= min_radius_m) || !(max_speed_mps > 0.0) || !(gap_s > 0.0) || !(speed_gap_s >= 0.0) || !(backward_tolerance_m >= 0.0) || !(backward_sigmas >= 0.0) ||
-      !(uturn_penalty >= 0.0) || !(outlier_penalty >= 0.0) || !(restart_penalty >= 0.0) || !(heading_sigma_deg > 0.0) ||
+      !(uturn_penalty >= 0.0) || !(outlier_penalty >= 0.0) || !(restart_penalty > 0.0) || !(heading_sigma_deg > 0.0) ||
       !std::isfinite(heading_sigma_deg) || !(heading_wide_sigma_deg > 0.0) || !std::isfinite(heading_wide_sigma_deg) ||
       !(heading_wide_share >= 0.0 && heading_wide_share <= 1.0) ||
       max_candidates == 0 || window == 0 || max_skipped > 16) {
     throw std::invalid_argument(
-        "map matcher configuration needs positive scales, radii, speed, gap and window, non-negative penalties, "
-        "finite heading sigmas, a wide heading share between 0 and 1, and at most 16 fixes set aside in a row");
+        "map matcher configuration needs positive scales, radii, speed, gap, window and restart penalty, "
+        "non-negative other penalties and speed gap, finite heading sigmas, a wide heading share between 0 and 1, "
+        "and at most 16 fixes set aside in a row");
   }
 }
 
@@ -41,7 +42,10 @@ HmmMatcher::HmmMatcher(const maps::RoadGraph& graph, const maps::EdgeSnapper& sn
   heading_log_at_zero_ = heading_log_likelihood(0.0);  // with the member still 0: the raw density
 }
 
-void HmmMatcher::reset() { window_.clear(); }
+void HmmMatcher::reset() {
+  window_.clear();
+  reported_chain_ = 0;
+}
 
 double HmmMatcher::heading_log_likelihood(double angle_deg) const {
   // The mixture's log density, summed in the log domain (a σ of a few degrees would underflow
@@ -222,11 +226,29 @@ MatchedPoint HmmMatcher::update(const GpsFix& fix, planner::BoundedDistances* le
     // A new chain: its first step is scored by the emission alone.
     step.chain_start = true;
     window_.clear();
+    const std::uint32_t chain = next_chain_++;
+    for (Candidate& c : step.candidates) c.chain = chain;
+  } else {
+    const Step& prev = window_.back();
+    for (Candidate& c : step.candidates) {
+      if (c.restart) {
+        c.chain = next_chain_++;
+      } else if (c.parent >= 0) {
+        c.chain = prev.candidates[static_cast<std::size_t>(c.parent)].chain;
+      }
+    }
   }
   window_.push_back(std::move(step));
   while (window_.size() > config_.window) window_.pop_front();
   const Step& now = window_.back();
-  return point_of(now, best(now));
+  const std::size_t at = best(now);
+  MatchedPoint m = point_of(now, at);
+  // A restart that wins only some fixes later is still a jump from the path reported before.
+  if (m.matched) {
+    m.chain_start = m.chain_start || now.candidates[at].chain != reported_chain_;
+    reported_chain_ = now.candidates[at].chain;
+  }
+  return m;
 }
 
 std::vector<MatchedPoint> HmmMatcher::match(std::span<const GpsFix> trace) {
@@ -278,8 +300,8 @@ std::vector<MatchedPoint> HmmMatcher::match(std::span<const GpsFix> trace) {
       if (k == first) break;
       const Candidate& c = steps[k].candidates[static_cast<std::size_t>(at)];
       if (c.restart) {
+        // Fixes set aside between the two parts stay unmatched and unflagged, as before a break.
         smooth_part(k, part_last);
-        for (std::size_t i = fix_of[k - 1] + 1; i < fix_of[k]; ++i) out[i].outlier = true;  // set aside between the parts
         part_last = --k;
         at = static_cast<std::int32_t>(best(steps[k]));
         continue;

@@ -40,9 +40,10 @@ struct HmmConfig {
   // Fixes further apart in time break the chain. A GPS outage of a few minutes (a tunnel) is
   // linked across: the route through it is checked against the straight line.
   double gap_s = 180.0;
-  // One fix's speed × the time since the last fix measures the distance driven only over a few
-  // seconds; over a longer gap (a tunnel) the vehicle may have stopped or sped up meanwhile.
-  double speed_gap_s = 5.0;
+  // One fix's speed × the time since the last fix measures the distance driven over the interval
+  // of a tracker's feed (up to this), not over a longer gap (a tunnel), in which the vehicle may
+  // have stopped or sped up meanwhile.
+  double speed_gap_s = 30.0;
   // The course over ground of a moving fix, against the road's bearing: a mixture of two
   // Gaussians. Along a road the course follows its bearing to within the receiver's course error,
   // a lane change and the road's drawing (heading_sigma_deg); through a junction's turn, or where
@@ -120,9 +121,10 @@ class HmmMatcher {
     maps::Point2 point;
     double distance_m;
     double score;         // log probability of the best path ending here
-    std::int32_t parent;  // index in the step `back` steps earlier, -1 at a chain start
+    std::int32_t parent;  // index in the step `back` steps earlier, -1 at a chain start or a restart
     std::uint8_t back = 1;  // batch: more than 1 where the best path sets fixes aside as outliers
     bool restart = false;   // the best path into it starts afresh here (restart_penalty)
+    std::uint32_t chain = 0;  // online: which unbroken path it is on (new at each break or restart)
   };
   struct Step {
     double time_s;
@@ -144,7 +146,7 @@ class HmmMatcher {
   struct Links {
     Links(const maps::RoadGraph& graph, const std::vector<Candidate>& next);
     std::vector<double> best;
-    std::vector<std::int32_t> parent;
+    std::vector<std::int32_t> parent;  // as Candidate::parent, or kRestart where it starts afresh
     std::vector<std::uint8_t> back;
     std::vector<NodeId> targets;
   };
@@ -172,6 +174,9 @@ class HmmMatcher {
   // the configuration: worked out once, not for every candidate.
   double heading_log_narrow_ = 0, heading_log_wide_ = 0, heading_log_at_zero_ = 0;
   std::deque<Step> window_;
+  // Online: the path of the last point reported, and the next path's number. A best candidate on
+  // another path than the last one reported is a jump with no route between: a chain start.
+  std::uint32_t reported_chain_ = 0, next_chain_ = 1;
 };
 
 }  // namespace corridor::localizer

@@ -25,7 +25,7 @@ struct SmootherConfig {
   double speed_sigma_mps = 0.5;      // of a receiver's speed
   double sigma_base_m = 4.0;         // position σ = HDOP × this, as the matcher's emission
   double default_hdop = 1.5;
-  double speed_gap_s = 5.0;          // the speeds say nothing of the distance driven over longer gaps
+  double speed_gap_s = 30.0;         // the speeds say nothing of the distance driven over longer gaps
 };
 
 // `points` is one unbroken chain matched from `fixes` (same length, first and last matched).

@@ -234,6 +234,16 @@ TEST(HmmMatcher, StartsAfreshWhereTheVehicleDroveOffTheMap) {
   std::vector<MatchedPoint> live;
   for (const GpsFix& f : trace) live.push_back(online.update(f));
   for (std::size_t i = 40; i < live.size(); ++i) EXPECT_EQ(way_of(g, live[i]), 2) << i;
+  // Online, the fix where way 2 first becomes the best is flagged: no route joins it to the
+  // point reported before, though its path started afresh some fixes earlier.
+  std::size_t flagged = 0;
+  for (std::size_t i = 1; i < live.size(); ++i) {
+    if (!live[i].chain_start) continue;
+    ++flagged;
+    EXPECT_EQ(way_of(g, live[i]), 2) << i;
+    EXPECT_EQ(way_of(g, live[i - 1]), 1) << i;
+  }
+  EXPECT_EQ(flagged, 1u);
   // Never starting afresh, both stay on the main road.
   HmmConfig never;
   never.restart_penalty = std::numeric_limits<double>::infinity();
