@@ -29,6 +29,26 @@ GpsFix fix_at(const maps::RoadGraph& g, double t, maps::Point2 p, std::optional<
 
 std::int64_t way_of(const maps::RoadGraph& g, const MatchedPoint& m) { return m.matched ? g.osm_way(m.edge).v : -1; }
 
+// One two-way road of 2 km, west to east along y = 0 (way 1).
+struct StraightRoad {
+  maps::RoadGraph g = [] {
+    Sketch s;
+    s.nodes = {{0, 0}, {2000, 0}};
+    s.roads = {{{0, 1}, false, 1}};
+    return s.build();
+  }();
+  maps::EdgeSnapper snapper{g};
+};
+
+// The trace fed fix by fix to an online matcher: what it reports after each.
+std::vector<MatchedPoint> match_online(const maps::RoadGraph& g, const maps::EdgeSnapper& snapper,
+                                       const std::vector<GpsFix>& trace, const HmmConfig& config = {}) {
+  HmmMatcher online(g, snapper, config);
+  std::vector<MatchedPoint> live;
+  for (const GpsFix& f : trace) live.push_back(online.update(f));
+  return live;
+}
+
 // A main road with a service road 12 m beside it, joined at both ends. Fixes along the main road
 // drift 7 m towards the service road, nearer to it than to the main road for half the drive: a
 // nearest-road snap jumps across; the HMM stays, since the jump would need a route through the
@@ -145,11 +165,9 @@ TEST(HmmMatcher, GoesRoundARoundabout) {
 }
 
 TEST(HmmMatcher, AGapOrNothingNearBreaksTheChainAndItRestarts) {
-  Sketch s;
-  s.nodes = {{0, 0}, {2000, 0}};
-  s.roads = {{{0, 1}, false, 1}};
-  const auto g = s.build();
-  const maps::EdgeSnapper snapper(g);
+  const StraightRoad road;
+  const maps::RoadGraph& g = road.g;
+  const maps::EdgeSnapper& snapper = road.snapper;
   HmmMatcher matcher(g, snapper);
   std::vector<GpsFix> trace;
   for (int i = 0; i < 5; ++i) trace.push_back(fix_at(g, i, {100.0 + i * 10, 1.0}));
@@ -175,9 +193,7 @@ TEST(HmmMatcher, AGapOrNothingNearBreaksTheChainAndItRestarts) {
   EXPECT_TRUE(m[12].matched && m[12].chain_start);
   EXPECT_TRUE(m[13].matched && !m[13].chain_start);
   // Online, which must answer at once, breaks at the first.
-  HmmMatcher online(g, snapper);
-  std::vector<MatchedPoint> live;
-  for (const GpsFix& f : trace) live.push_back(online.update(f));
+  const auto live = match_online(g, snapper, trace);
   EXPECT_FALSE(live[5].matched);
   EXPECT_TRUE(live[6].chain_start);
   EXPECT_TRUE(live[7].chain_start);
@@ -188,11 +204,9 @@ TEST(HmmMatcher, AGapOrNothingNearBreaksTheChainAndItRestarts) {
 // against the straight line, not against the one speed the fix after it reports. That fix was
 // taken standing in a queue; its speed × 90 s says 0 m were driven, where 860 m were.
 TEST(HmmMatcher, LinksAcrossAGapOfMinutesWithoutTrustingOneFixsSpeed) {
-  Sketch s;
-  s.nodes = {{0, 0}, {2000, 0}};
-  s.roads = {{{0, 1}, false, 1}};
-  const auto g = s.build();
-  const maps::EdgeSnapper snapper(g);
+  const StraightRoad road;
+  const maps::RoadGraph& g = road.g;
+  const maps::EdgeSnapper& snapper = road.snapper;
   std::vector<GpsFix> trace;
   for (int i = 0; i < 5; ++i) trace.push_back(fix_at(g, i, {100.0 + i * 10, 1.0}, 90.0, 10.0));
   trace.push_back(fix_at(g, 94, {1000, 1.0}, 90.0, 0.0));
@@ -200,9 +214,7 @@ TEST(HmmMatcher, LinksAcrossAGapOfMinutesWithoutTrustingOneFixsSpeed) {
   const auto m = HmmMatcher(g, snapper).match(trace);
   ASSERT_TRUE(m[5].matched);
   EXPECT_FALSE(m[5].chain_start);
-  HmmMatcher online(g, snapper);
-  std::vector<MatchedPoint> live;
-  for (const GpsFix& f : trace) live.push_back(online.update(f));
+  const auto live = match_online(g, snapper, trace);
   ASSERT_TRUE(live[5].matched);
   EXPECT_FALSE(live[5].chain_start);
   // A gap longer than gap_s still breaks the chain.
@@ -230,9 +242,7 @@ TEST(HmmMatcher, StartsAfreshWhereTheVehicleDroveOffTheMap) {
   bool restarted = false;
   for (std::size_t i = 28; i < 36; ++i) restarted = restarted || m[i].chain_start;
   EXPECT_TRUE(restarted);
-  HmmMatcher online(g, snapper);
-  std::vector<MatchedPoint> live;
-  for (const GpsFix& f : trace) live.push_back(online.update(f));
+  const auto live = match_online(g, snapper, trace);
   for (std::size_t i = 40; i < live.size(); ++i) EXPECT_EQ(way_of(g, live[i]), 2) << i;
   // Online, the fix where way 2 first becomes the best is flagged: no route joins it to the
   // point reported before, though its path started afresh some fixes earlier.
@@ -248,10 +258,7 @@ TEST(HmmMatcher, StartsAfreshWhereTheVehicleDroveOffTheMap) {
   HmmConfig never;
   never.restart_penalty = std::numeric_limits<double>::infinity();
   EXPECT_EQ(way_of(g, HmmMatcher(g, snapper, never).match(trace).back()), 1);
-  HmmMatcher glued(g, snapper, never);
-  MatchedPoint last;
-  for (const GpsFix& f : trace) last = glued.update(f);
-  EXPECT_EQ(way_of(g, last), 1);
+  EXPECT_EQ(way_of(g, match_online(g, snapper, trace, never).back()), 1);
 }
 
 // A multipath fix lands on the top of a block beside the main road, where a drive round the block
@@ -288,11 +295,9 @@ TEST(HmmMatcher, SetsAsideAMultipathFixThatOnlyADetourCouldReach) {
 // Skip arcs weigh the whole path through it, on one scale across steps, against the price of an
 // outlier: it is set aside (a comparison of the moves alone would keep it).
 TEST(HmmMatcher, SetsAsideAFixFarFromTheRoadEvenWhenItsMovesFit) {
-  Sketch s;
-  s.nodes = {{0, 0}, {2000, 0}};
-  s.roads = {{{0, 1}, false, 1}};
-  const auto g = s.build();
-  const maps::EdgeSnapper snapper(g);
+  const StraightRoad road;
+  const maps::RoadGraph& g = road.g;
+  const maps::EdgeSnapper& snapper = road.snapper;
   std::vector<GpsFix> trace;
   for (int i = 0; i <= 12; ++i) trace.push_back(fix_at(g, i * 5.0, {300.0 + i * 50.0, i == 5 ? 28.0 : 0.5}, 90.0, 10.0));
   const auto m = HmmMatcher(g, snapper).match(trace);
@@ -371,9 +376,7 @@ TEST(HmmMatcher, TheCourseTellsTheBranchesOfAShallowForkApart) {
   };
   HmmMatcher batch(g, snapper);
   on_road_2_after_the_fork(batch.match(trace), "batch");
-  HmmMatcher online(g, snapper);
-  std::vector<MatchedPoint> live;
-  for (const GpsFix& f : trace) live.push_back(online.update(f));
+  const auto live = match_online(g, snapper, trace);
   on_road_2_after_the_fork(live, "online");
   // The case is hard for a single wide Gaussian in the course.
   HmmMatcher wide(g, snapper, HmmConfig{.heading_sigma_deg = 40.0, .heading_wide_share = 0.0});
