@@ -19,7 +19,7 @@ constexpr std::int32_t kRestart = -2;  // a parent in Links: the path starts afr
 void HmmConfig::validate() const {
   if (!(sigma_base_m > 0.0) || !(default_hdop > 0.0) || !(beta_m > 0.0) || !(min_radius_m > 0.0) ||
       !(max_radius_m >= min_radius_m) || !(max_speed_mps > 0.0) || !(gap_s > 0.0) || !(speed_gap_s >= 0.0) || !(backward_tolerance_m >= 0.0) || !(backward_sigmas >= 0.0) ||
-      !(uturn_penalty >= 0.0) || !(outlier_penalty >= 0.0) || !(restart_penalty > 0.0) || !(heading_sigma_deg > 0.0) ||
+      !(uturn_penalty >= 0.0) || !(service_entry_penalty >= 0.0) || !(outlier_penalty >= 0.0) || !(restart_penalty > 0.0) || !(heading_sigma_deg > 0.0) ||
       !std::isfinite(heading_sigma_deg) || !(heading_wide_sigma_deg > 0.0) || !std::isfinite(heading_wide_sigma_deg) ||
       !(heading_wide_share >= 0.0 && heading_wide_share <= 1.0) ||
       max_candidates == 0 || window == 0 || max_skipped > 16) {
@@ -130,6 +130,9 @@ void HmmMatcher::relax(const Step& prev, const Step& next, const GpsFix& fix, do
       double transition = use_speed ? -std::abs(route - straight) / (2.0 * beta) - std::abs(route - *fix.speed_mps * dt) / beta
                                      : -std::abs(route - straight) / beta;
       if (c.edge == graph_.twin(p.edge)) transition -= config_.uturn_penalty;
+      if (graph_.road_class(c.edge) == maps::RoadClass::service && graph_.road_class(p.edge) != maps::RoadClass::service) {
+        transition -= config_.service_entry_penalty;
+      }
       const double score = p.score + (prev.norm - base) + transition - penalty;
       if (score > links.best[j]) {
         links.best[j] = score;

@@ -65,6 +65,12 @@ struct HmmConfig {
   // cheap as standing still where a stopped vehicle's fixes scatter across a junction. Its price,
   // as a log-likelihood.
   double uturn_penalty = 4.0;
+  // A move from a through road onto a service road (a car park's aisle, a bypass drawn a few
+  // metres beside its street) pays this (a log-likelihood, about a 1.4σ emission): where the fixes
+  // fit both alike, the through road is the likelier drive; where they leave for the service
+  // road, they outweigh it within a fix or two. Measured on drives that use service roads too
+  // (docs/experiments/localization.md).
+  double service_entry_penalty = 1.0;
   std::size_t window = 8;         // online: steps kept (the lag bound)
   // Batch: fixes in a row that may be set aside as outliers (multipath) before the chain breaks
   // (at most 16). A fix nothing reaches, or with no road near, is set aside outright; any other

@@ -310,6 +310,38 @@ TEST(HmmMatcher, SetsAsideAFixFarFromTheRoadEvenWhenItsMovesFit) {
   }
 }
 
+// A service road (way 2) drawn 3 m beside its street (way 1), joined at both ends. The fixes run
+// between them, 1.2 m from the service road and 1.8 m from the street: the emissions favour the
+// service road (by 0.7 over the drive), by less than the price of entering it, so the street
+// keeps the match. A vehicle that does turn into
+// a service road, 30 m off, is followed onto it all the same.
+TEST(HmmMatcher, AServiceRoadBesideItsStreetPaysToEnter) {
+  Sketch s;
+  s.nodes = {{0, 0}, {100, 0}, {400, 0}, {600, 0}, {110, 3}, {390, 3}, {450, 0}, {450, 30}, {600, 30}};
+  s.roads = {{{0, 1, 2, 6, 3}, false, 1},
+             {{1, 4, 5, 2}, false, 2, maps::RoadClass::service},
+             {{6, 7, 8}, false, 3, maps::RoadClass::service}};
+  const auto g = s.build();
+  const maps::EdgeSnapper snapper(g);
+  std::vector<GpsFix> beside;
+  for (int i = 0; i <= 40; ++i) {
+    const double x = 10.0 * i;  // 10 m/s east, to x = 400
+    beside.push_back(fix_at(g, i, {x, x > 110.0 && x < 390.0 ? 1.8 : 0.0}, 90.0, 10.0));
+  }
+  const auto m = HmmMatcher(g, snapper).match(beside);
+  for (std::size_t i = 0; i < m.size(); ++i) EXPECT_EQ(way_of(g, m[i]), 1) << i;
+  HmmConfig free_entry;
+  free_entry.service_entry_penalty = 0.0;
+  EXPECT_EQ(way_of(g, HmmMatcher(g, snapper, free_entry).match(beside)[25]), 2);
+  // Into the service road at x = 450 and along it, 30 m north of the street.
+  std::vector<GpsFix> into;
+  for (int i = 0; i <= 44; ++i) into.push_back(fix_at(g, i, {10.0 * i, 0.0}, 90.0, 10.0));  // to x = 440
+  for (int i = 1; i <= 3; ++i) into.push_back(fix_at(g, 44 + i, {450, 10.0 * i}, 0.0, 10.0));
+  for (int i = 1; i <= 10; ++i) into.push_back(fix_at(g, 47 + i, {450.0 + 10.0 * i, 30.0}, 90.0, 10.0));
+  const auto in = HmmMatcher(g, snapper).match(into);
+  for (std::size_t i = in.size() - 10; i < in.size(); ++i) EXPECT_EQ(way_of(g, in[i]), 3) << i;
+}
+
 // A vehicle waits 5 m before a junction; its fixes scatter by σ 5 m, some of them well behind
 // the one before (more than a fixed tolerance of 8 m). Standing still is the explanation, not a
 // U-turn or the side street: every fix stays on the approach, in the direction it came.

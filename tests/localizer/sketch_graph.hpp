@@ -15,6 +15,7 @@ struct Sketch {
     std::vector<std::uint32_t> through;
     bool oneway = false;
     std::int64_t way = 0;
+    maps::RoadClass road_class = maps::RoadClass::residential;
   };
   std::vector<Road> roads;
 
@@ -39,6 +40,7 @@ struct Sketch {
         s.backward = !r.oneway;
         s.forward_speed_mps = s.backward_speed_mps = 14.0f;
         s.way = OsmWayId{r.way};
+        s.road_class = r.road_class;
         in.segments.push_back(s);
       }
     }
