@@ -107,6 +107,8 @@ void HmmMatcher::relax(const Step& prev, const Step& next, const GpsFix& fix, do
     const Candidate& p = prev.candidates[i];
     if (p.score == kNoScore) continue;
     const double to_end = graph_.length_m(p.edge) - p.offset_m;
+    // A move onto a service road pays to enter it, not to go on along it.
+    const double service_entry = graph_.road_class(p.edge) == maps::RoadClass::service ? 0.0 : config_.service_entry_penalty;
     bool searched = false;
     for (std::size_t j = 0; j < next.candidates.size(); ++j) {
       const Candidate& c = next.candidates[j];
@@ -130,9 +132,7 @@ void HmmMatcher::relax(const Step& prev, const Step& next, const GpsFix& fix, do
       double transition = use_speed ? -std::abs(route - straight) / (2.0 * beta) - std::abs(route - *fix.speed_mps * dt) / beta
                                      : -std::abs(route - straight) / beta;
       if (c.edge == graph_.twin(p.edge)) transition -= config_.uturn_penalty;
-      if (graph_.road_class(c.edge) == maps::RoadClass::service && graph_.road_class(p.edge) != maps::RoadClass::service) {
-        transition -= config_.service_entry_penalty;
-      }
+      if (graph_.road_class(c.edge) == maps::RoadClass::service) transition -= service_entry;
       const double score = p.score + (prev.norm - base) + transition - penalty;
       if (score > links.best[j]) {
         links.best[j] = score;

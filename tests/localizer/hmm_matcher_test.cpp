@@ -31,12 +31,7 @@ std::int64_t way_of(const maps::RoadGraph& g, const MatchedPoint& m) { return m.
 
 // One two-way road of 2 km, west to east along y = 0 (way 1).
 struct StraightRoad {
-  maps::RoadGraph g = [] {
-    Sketch s;
-    s.nodes = {{0, 0}, {2000, 0}};
-    s.roads = {{{0, 1}, false, 1}};
-    return s.build();
-  }();
+  maps::RoadGraph g = testing::straight_road(2000.0);
   maps::EdgeSnapper snapper{g};
 };
 
@@ -423,10 +418,7 @@ TEST(HmmMatcher, TheCourseTellsTheBranchesOfAShallowForkApart) {
 }
 
 TEST(HmmMatcher, RejectsUnsortedTimesAndNonFiniteFixes) {
-  Sketch s;
-  s.nodes = {{0, 0}, {500, 0}};
-  s.roads = {{{0, 1}, false, 1}};
-  const auto g = s.build();
+  const auto g = testing::straight_road(500.0);
   const maps::EdgeSnapper snapper(g);
   HmmMatcher matcher(g, snapper);
   std::vector<GpsFix> unsorted{fix_at(g, 5, {10, 0}), fix_at(g, 4, {20, 0})};

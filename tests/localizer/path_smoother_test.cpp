@@ -17,12 +17,7 @@ using testing::edge_between;
 
 // A straight two-way road, 1 km, driven east at 10 m/s with a fix a second.
 struct StraightDrive {
-  maps::RoadGraph g = [] {
-    Sketch s;
-    s.nodes = {{0, 0}, {1000, 0}};
-    s.roads = {{{0, 1}, false, 1}};
-    return s.build();
-  }();
+  maps::RoadGraph g = testing::straight_road(1000.0);
   planner::BoundedDistances distances{g.node_count()};
   std::vector<GpsFix> fixes;
   std::vector<MatchedPoint> points;

@@ -48,6 +48,14 @@ struct Sketch {
   }
 };
 
+// One two-way road (way 1) from (0, 0) east to (length_m, 0).
+inline maps::RoadGraph straight_road(double length_m) {
+  Sketch s;
+  s.nodes = {{0, 0}, {length_m, 0}};
+  s.roads = {{{0, 1}, false, 1}};
+  return s.build();
+}
+
 // The directed edge from the node at `from` to the node at `to` (within a metre), or invalid.
 inline EdgeId edge_between(const maps::RoadGraph& g, maps::Point2 from, maps::Point2 to) {
   for (EdgeId e : g.edges()) {
