@@ -24,6 +24,7 @@ GpsOdometryLocalizer::GpsOdometryLocalizer(const maps::RoadGraph& graph, const m
       config_(config),
       hmm_(graph, snapper, config.hmm),
       odometry_(graph, config.odometry, &snapper),
+      scale_(config.odometry_scale),
       takeover_s_(config.gps_timeout_s) {}
 
 double GpsOdometryLocalizer::road_heading_deg(EdgeId e, double offset_m) const {
@@ -159,6 +160,9 @@ LocalizedPoint GpsOdometryLocalizer::on_gps(const GpsFix& fix) {
     }
     return last_;
   }
+  // Only a good fix's speed calibrates the odometry's scale; it is the odometry as reported,
+  // before the correction, that is measured against it.
+  scale_.on_fix(fix.time_s, fix.speed_mps, raw_odometry_m_);
   const MatchedPoint matched = hmm_.update(fix);
   if (!matched.matched) return last_;
   const double sigma = usable_hdop(fix, config_.hmm.default_hdop) * config_.hmm.sigma_base_m;
@@ -237,7 +241,10 @@ double GpsOdometryLocalizer::takeover_s() const {
   return std::clamp(config_.gps_overdue_intervals * *mid, config_.gps_min_takeover_s, config_.gps_timeout_s);
 }
 
-LocalizedPoint GpsOdometryLocalizer::on_odometry(const OdometryStep& step) {
+LocalizedPoint GpsOdometryLocalizer::on_odometry(const OdometryStep& reported) {
+  if (std::isfinite(reported.distance_m)) raw_odometry_m_ += std::max(0.0, reported.distance_m);
+  OdometryStep step = reported;
+  step.distance_m *= scale_.factor();
   if (std::isfinite(step.distance_m)) odometry_m_ += std::max(0.0, step.distance_m);
   if (std::isfinite(step.time_s)) last_odometry_s_ = step.time_s;
   if (std::isfinite(step.distance_m)) {

@@ -13,6 +13,7 @@
 #include <optional>
 
 #include "localizer/fusion/odometry_map_matcher.hpp"
+#include "localizer/fusion/odometry_scale.hpp"
 #include "localizer/match/hmm_matcher.hpp"
 
 namespace corridor::localizer {
@@ -20,6 +21,7 @@ namespace corridor::localizer {
 struct LocalizerConfig {
   HmmConfig hmm;
   OdometryMatchConfig odometry;
+  OdometryScaleConfig odometry_scale;  // the odometry's distances, calibrated by the receiver's speed
   double max_gps_hdop = 10.0;   // the seed's switch
   double gps_timeout_s = 2.5;   // no good fix for this long: odometry...
   // ...or for this many of the receiver's own intervals (the median of its last gaps), if sooner,
@@ -74,6 +76,8 @@ class GpsOdometryLocalizer {
   LocalizedPoint on_odometry(const OdometryStep& step);
 
   [[nodiscard]] const LocalizedPoint& last() const { return last_; }
+  // What the odometry's distances are multiplied by (1 until calibrated).
+  [[nodiscard]] double odometry_scale() const { return scale_.factor(); }
 
  private:
   LocalizedPoint output(PositionSource source, const MatchedPoint& m, double sigma_m);
@@ -84,6 +88,7 @@ class GpsOdometryLocalizer {
   LocalizerConfig config_;
   HmmMatcher hmm_;
   OdometryMapMatcher odometry_;
+  OdometryScale scale_;
   double last_good_gps_s_ = -1e18;
   double last_fix_s_ = -1e18;  // the last fix of any quality, for the receiver's interval...
   std::deque<double> fix_gaps_;  // ...its last gaps
@@ -93,7 +98,8 @@ class GpsOdometryLocalizer {
   // stopped keeps facing the way it drove, though the road alone cannot say which way that was.
   std::optional<double> course_deg_;
   double driven_since_course_m_ = 0;
-  double odometry_m_ = 0;  // every metre the odometry reported
+  double odometry_m_ = 0;  // every metre the odometry reported, scale-corrected
+  double raw_odometry_m_ = 0;  // the same as reported, for the scale's calibration
   double last_odometry_s_ = -1e18;  // when it last reported
   struct RecentFix {
     EdgeId edge;
