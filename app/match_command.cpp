@@ -147,6 +147,8 @@ struct MatchBenchOptions {
   double noise_m = 5.0;
   double outliers = 0.0;
   std::uint64_t seed = 1;
+  localizer::VoDriftModel odometry;  // the study's simulated odometry errors
+  bool scale_calibration = true;     // the fusion calibrates the odometry's scale by the receiver's speed
 };
 
 json drive_json(const localizer::DriveResult& d) {
@@ -180,12 +182,20 @@ json drive_json(const localizer::DriveResult& d) {
            ratio(static_cast<double>(d.outage_correct_nearest_oracle), static_cast<double>(d.outage_samples_nearest_oracle))},
           {"truth_from_lane_share", ratio(static_cast<double>(d.truth_from_lane), static_cast<double>(d.samples))},
           {"recovery_s", d.recovery_s},
-          {"handback_jump_m", d.handback_jump_m}};
+          {"handback_jump_m", d.handback_jump_m},
+          // The odometry's scale error as the outage begins (RMS over drives): as simulated, and
+          // after the fusion's calibration against the receiver's speed.
+          {"odometry_scale_error_raw", rmse(d.scale_sq_raw, d.scale_n)},
+          {"odometry_scale_error", rmse(d.scale_sq_calibrated, d.scale_n)}};
 }
 
 void run_fcd_study(const MatchBenchOptions& o) {
   if (!(o.noise_m >= 0.0) || !(o.outliers >= 0.0 && o.outliers <= 1.0) || !(o.outage_s >= 0.0)) {
     throw UsageError("--noise-m and --outage-s must be >= 0 and --outliers within [0, 1]");
+  }
+  if (!(o.odometry.scale_sigma >= 0.0 && o.odometry.scale_sigma < 0.2) || !(o.odometry.heading_deg_per_100m >= 0.0) ||
+      !(o.odometry.heading_deg_per_100m < 90.0)) {
+    throw UsageError("--odometry-scale-sigma must be within [0, 0.2) and --odometry-heading-deg-per-100m within [0, 90)");
   }
   const maps::RoadGraph graph = load_map_from_options(o.map);
   const maps::EdgeSnapper snapper(graph);
@@ -199,6 +209,8 @@ void run_fcd_study(const MatchBenchOptions& o) {
   config.outlier_share = o.outliers;
   config.outage_s = o.outage_s;
   config.seed = o.seed;
+  config.odometry = o.odometry;
+  config.localizer.odometry_scale.enabled = o.scale_calibration;
   localizer::DrivePlot plot;
   const std::string plot_id = o.plot_id.empty() ? drives.begin()->first : o.plot_id;
   const auto started = std::chrono::steady_clock::now();
@@ -324,6 +336,14 @@ void register_match_bench(CLI::App& bench) {
   cmd->add_option("--plot", o->plot, "with --fcd: an SVG of one drive");
   cmd->add_option("--plot-id", o->plot_id, "with --fcd: the drive to plot (FILE:VEHICLE; default the first)");
   cmd->add_option("--csv", o->csv, "with --fcd: per-drive figures as CSV");
+  cmd->add_option("--odometry-scale-sigma", o->odometry.scale_sigma,
+                  "with --fcd: 1σ of the simulated odometry's per-drive scale error (0.0062: our VO's t_err)")
+      ->capture_default_str();
+  cmd->add_option("--odometry-heading-deg-per-100m", o->odometry.heading_deg_per_100m,
+                  "with --fcd: 1σ of the simulated odometry's heading random walk per 100 m (our VO's r_err)")
+      ->capture_default_str();
+  cmd->add_flag("!--no-scale-calibration", o->scale_calibration,
+                "with --fcd: the fusion takes the odometry's distances as reported, without calibrating them by the receiver's speed");
   cmd->callback([o] { run_match_bench(*o); });
 }
 

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <random>
 
 #include "localizer/fusion/odometry_map_matcher.hpp"
@@ -19,8 +20,14 @@ class SimulatedOdometry {
  public:
   SimulatedOdometry(VoDriftModel model, std::uint64_t seed);
 
-  // The increment from one true pose to the next (headings clockwise from north).
-  OdometryStep step(double time_s, maps::Point2 from, double from_heading_deg, maps::Point2 to, double to_heading_deg);
+  // The increment from one true pose to the next (headings clockwise from north). The distance
+  // driven is path_m when the caller knows it (a trajectory sampled at 1 Hz cuts each bend with a
+  // chord, 1–2 % shorter than the road on a 30 m radius, where a 10 Hz odometry follows the
+  // road), else the straight line between the poses.
+  OdometryStep step(double time_s, maps::Point2 from, double from_heading_deg, maps::Point2 to, double to_heading_deg,
+                    std::optional<double> path_m = std::nullopt);
+  // The drive's scale: reported distance over true distance.
+  [[nodiscard]] double scale() const { return scale_; }
 
  private:
   VoDriftModel model_;

@@ -56,6 +56,10 @@ struct DriveResult {
   double outage_sq = 0;
   double recovery_s = 0;    // after the outage: until the fused estimate is on the true edge again
   double handback_jump_m = 0;  // how far the position moved when GPS came back
+  // The odometry's scale error when the outage begins, as simulated and after the fusion's
+  // calibration against the receiver's speed: squared sums over drives with an outage.
+  double scale_sq_raw = 0, scale_sq_calibrated = 0;
+  std::size_t scale_n = 0;
 };
 
 struct StudyResult {
