@@ -48,7 +48,15 @@ struct TruthRow {
   double time_s;
   maps::Point2 position;
   double heading_deg;  // clockwise from north
+  double arc_m;        // driven since the start
 };
+
+// The speed at row k: the distance driven over the rows either side of it.
+double truth_speed_mps(const std::vector<TruthRow>& rows, std::size_t k) {
+  const std::size_t a = k > 0 ? k - 1 : k, b = std::min(k + 1, rows.size() - 1);
+  const double dt = rows[b].time_s - rows[a].time_s;
+  return dt > 0.0 ? std::max(0.0, (rows[b].arc_m - rows[a].arc_m) / dt) : 0.0;
+}
 
 // drive.csv from `corridor vo synth`: frame,time_s,x_m,y_m,heading_rad,arc_m (map frame).
 std::vector<TruthRow> read_drive_csv(const std::string& path) {
@@ -65,9 +73,9 @@ std::vector<TruthRow> read_drive_csv(const std::string& path) {
     std::string f;
     std::vector<double> v;
     while (std::getline(ss, f, ',')) v.push_back(std::stod(f));
-    if (v.size() < 5) throw UsageError("'" + path + "': short line");
+    if (v.size() < 6) throw UsageError("'" + path + "': short line");
     // heading_rad is counter-clockwise from east; the map's headings are clockwise from north.
-    rows.push_back({v[1], {v[2], v[3]}, std::fmod(90.0 - v[4] * 180.0 / std::numbers::pi + 720.0, 360.0)});
+    rows.push_back({v[1], {v[2], v[3]}, std::fmod(90.0 - v[4] * 180.0 / std::numbers::pi + 720.0, 360.0), v[5]});
   }
   if (rows.size() < 2) throw UsageError("'" + path + "' has no drive");
   return rows;
@@ -107,7 +115,7 @@ void run_localize(const LocalizeOptions& o) {
     gps = localizer::read_trace(o.gps);
   } else {
     std::mt19937_64 rng(o.seed);
-    std::normal_distribution<double> noise(0.0, o.gps_noise_m);
+    std::normal_distribution<double> noise(0.0, o.gps_noise_m), unit(0.0, 1.0);
     std::size_t k = 0;
     for (double t = truth.front().time_s; t <= truth.back().time_s; t += 1.0 / o.gps_rate_hz) {
       while (k + 1 < truth.size() && truth[k + 1].time_s <= t) ++k;
@@ -117,6 +125,11 @@ void run_localize(const LocalizeOptions& o) {
       f.time_s = t;
       f.position = graph.projection().to_lat_lon({truth[k].position.x_m + noise(rng), truth[k].position.y_m + noise(rng)});
       f.hdop = std::max(1.0, o.gps_noise_m / 4.0);
+      // A receiver's Doppler speed (±0.3 m/s) and, while moving, its course over ground (±5°), as
+      // every NMEA receiver gives them (RMC) and as the localization study simulates them.
+      const double v = truth_speed_mps(truth, k);
+      f.speed_mps = std::max(0.0, v + 0.3 * unit(rng));
+      if (v > 3.0) f.heading_deg = std::fmod(truth[k].heading_deg + 5.0 * unit(rng) + 360.0, 360.0);
       gps.push_back(f);
     }
   }
@@ -137,7 +150,7 @@ void run_localize(const LocalizeOptions& o) {
     localizer::SimulatedOdometry simulated({}, o.seed + 1);
     for (std::size_t i = 1; i < truth.size(); ++i) {
       odometry.push_back(simulated.step(truth[i].time_s, truth[i - 1].position, truth[i - 1].heading_deg,
-                                        truth[i].position, truth[i].heading_deg));
+                                        truth[i].position, truth[i].heading_deg, truth[i].arc_m - truth[i - 1].arc_m));
     }
   }
 
@@ -244,7 +257,9 @@ void register_localize_command(CLI::App& app) {
   cmd->add_option("--truth", o->truth, "drive.csv from corridor vo synth: scores the output and feeds the simulations");
   cmd->add_flag("--json", o->json, "print the summary and every position as JSON");
   cmd->add_option("--out", o->out, "write the positions as a JSON array");
-  cmd->add_option("--gps-noise-m", o->gps_noise_m, "simulated GPS noise σ")->capture_default_str();
+  cmd->add_option("--gps-noise-m", o->gps_noise_m,
+                  "simulated GPS noise σ (the simulated receiver also gives its speed, ±0.3 m/s, and course, ±5°)")
+      ->capture_default_str();
   cmd->add_option("--gps-rate-hz", o->gps_rate_hz, "simulated GPS rate, and the output rate")->capture_default_str();
   cmd->add_option("--gps-outage", o->gps_outages, "START:DURATION seconds without simulated GPS (repeatable)");
   cmd->add_option("--seed", o->seed, "simulation seed")->capture_default_str();
