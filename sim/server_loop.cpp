@@ -83,7 +83,13 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
   std::mt19937_64 rng(config.seed * 7919 + 3);
   std::normal_distribution<double> gauss(0.0, 1.0);
   localizer::SimulatedOdometry odometry({}, config.seed * 7919 + 5);
-  std::optional<std::pair<maps::Point2, double>> last_truth;  // position, angle
+  struct Pose {
+    maps::Point2 position;
+    double angle_deg = 0;
+    double speed_mps = 0;
+    double time_s = 0;
+  };
+  std::optional<Pose> last_truth;
   double last_fix_s = -1e9;
   std::optional<std::uint64_t> mission;
   std::vector<std::string> route;
@@ -180,8 +186,17 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
           // The receiver and the onboard localizer: odometry every step, a fix at the GPS rate.
           const maps::Point2 truth{pos->x, pos->y};
           const double angle = sumo_angle;
-          if (last_truth) onboard.on_odometry(odometry.step(t, last_truth->first, last_truth->second, truth, angle));
-          last_truth = {truth, angle};
+          const double speed = as_double(ev, libsumo::VAR_SPEED);
+          if (last_truth) {
+            // The distance driven along the lane (the mean of the step's two speeds, as SUMO's
+            // ballistic update moves it); the straight line cuts bends.
+            std::optional<double> path_m;
+            if (last_truth->speed_mps > 0.0 && speed > 0.0 && t > last_truth->time_s) {
+              path_m = std::max(maps::distance_m(last_truth->position, truth), 0.5 * (last_truth->speed_mps + speed) * (t - last_truth->time_s));
+            }
+            onboard.on_odometry(odometry.step(t, last_truth->position, last_truth->angle_deg, truth, angle, path_m));
+          }
+          last_truth = Pose{truth, angle, speed, t};
           const double since = t - ev_depart;
           const bool out = std::any_of(config.gps_outages.begin(), config.gps_outages.end(),
                                        [&](const auto& w) { return since >= w.first && since < w.second; });
@@ -190,13 +205,18 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
             const double sigma = out ? 40.0 : config.gps_noise_m;  // multipath under a roof of buildings
             const maps::Point2 noisy{truth.x_m + sigma * gauss(rng), truth.y_m + sigma * gauss(rng)};
             const double hdop = out ? 15.0 : std::max(1.0, config.gps_noise_m / 4.0);
-            json fix = position_json(g, noisy, std::fmod(angle + 5.0 * gauss(rng) + 360.0, 360.0),
-                                     as_double(ev, libsumo::VAR_SPEED), now);
+            // The receiver's course (±5°) and Doppler speed (±0.3 m/s), reported to the server and
+            // used on board (the odometry's scale is calibrated against the speed).
+            const double course = std::fmod(angle + 5.0 * gauss(rng) + 360.0, 360.0);
+            const double doppler = std::max(0.0, speed + 0.3 * gauss(rng));
+            json fix = position_json(g, noisy, course, doppler, now);
             fix["hdop"] = hdop;
             localizer::GpsFix f;
             f.time_s = t;
             f.position = g.projection().to_lat_lon(noisy);
             f.hdop = hdop;
+            f.speed_mps = doppler;
+            if (speed > 3.0) f.heading_deg = course;
             onboard.on_gps(f);
             if (!out) {
               report = std::move(fix);
