@@ -30,6 +30,7 @@ FIGURES = [
     ("rmse_hmm_m", "RMSE m", 1.0, 2),
     ("rmse_hmm_on_graph_m", "RMSE on graph m", 1.0, 2),
     ("outage_correct_edge_share", "outage %", 100.0, 2),
+    ("outage_rmse_m", "outage RMSE m", 1.0, 1),
 ]
 
 
