@@ -29,6 +29,84 @@ double driven_m(std::span<const GpsFix> fixes, std::size_t a, std::size_t b, dou
   return sum;
 }
 
+// The distance a vehicle drives along a matched path, against the path's own distance s along the
+// road's centre lines. A vehicle rounds each corner on an arc instead of running to the vertex and
+// turning there, and keeps to its side of a two-way road, so a right turn is shorter for it and a
+// left turn longer by its offset times the angle. The receiver's speeds measure the driven
+// distance u; the fixes' projections measure s. u(s) is piecewise linear (each vertex's difference
+// spread over the arc), increasing, and inverted by bisection over its breakpoints.
+class DrivenCoordinate {
+ public:
+  DrivenCoordinate(const maps::RoadGraph& g, const std::vector<Occurrence>& path, double corner_radius_m, double lane_offset_m) {
+    struct Vertex {
+      maps::Point2 p;
+      double s;
+      double offset;  // the lane offset on the segment that ends here
+    };
+    std::vector<Vertex> v;
+    for (const Occurrence& o : path) {
+      const auto pts = g.geometry(o.edge);
+      double geometric = 0.0;
+      for (std::size_t i = 1; i < pts.size(); ++i) geometric += maps::distance_m(pts[i - 1], pts[i]);
+      const double scale = geometric > 0.0 ? g.length_m(o.edge) / geometric : 1.0;
+      const double offset = g.twin(o.edge).valid() ? lane_offset_m : 0.0;
+      double at = o.s_start;
+      if (v.empty()) v.push_back({pts.front(), at, offset});
+      for (std::size_t i = 1; i < pts.size(); ++i) {
+        at += maps::distance_m(pts[i - 1], pts[i]) * scale;
+        if (at - v.back().s < 0.05) continue;
+        v.push_back({pts[i], at, offset});
+      }
+    }
+    struct Ramp {
+      double from, to, delta;
+    };
+    std::vector<Ramp> ramps;
+    for (std::size_t j = 1; j + 1 < v.size(); ++j) {
+      const double ax = v[j].p.x_m - v[j - 1].p.x_m, ay = v[j].p.y_m - v[j - 1].p.y_m;
+      const double bx = v[j + 1].p.x_m - v[j].p.x_m, by = v[j + 1].p.y_m - v[j].p.y_m;
+      double theta = -std::atan2(ax * by - ay * bx, ax * bx + ay * by);  // right turns positive
+      theta = std::clamp(theta, -2.6, 2.6);  // no tighter than 150°
+      const double abs_theta = std::abs(theta);
+      if (abs_theta < 1e-3) continue;
+      const double a = v[j].s - v[j - 1].s, b = v[j + 1].s - v[j].s;
+      const double tan_half = std::tan(0.5 * abs_theta);
+      const double r = std::min(corner_radius_m, 0.5 * std::min(a, b) / tan_half);
+      const double tangent = r * tan_half;
+      const double d = 0.5 * (v[j].offset + v[j + 1].offset);
+      const double delta = 2.0 * tangent - r * abs_theta + d * theta;
+      const double w = std::max({tangent, std::abs(delta), 0.5});
+      ramps.push_back({v[j].s - w, v[j].s + w, delta});
+    }
+    std::vector<double> at;
+    at.push_back(path.front().s_start - 1e6);
+    for (const Ramp& r : ramps) at.push_back(r.from), at.push_back(r.to);
+    at.push_back(path.back().s_start + g.length_m(path.back().edge) + 1e6);
+    std::sort(at.begin(), at.end());
+    s_ = at;
+    u_.resize(at.size());
+    for (std::size_t k = 0; k < at.size(); ++k) {
+      double u = at[k];
+      for (const Ramp& r : ramps) u -= r.delta * std::clamp((at[k] - r.from) / (r.to - r.from), 0.0, 1.0);
+      if (k > 0) u = std::max(u, u_[k - 1] + 0.05 * (at[k] - at[k - 1]));
+      u_[k] = u;
+    }
+  }
+  [[nodiscard]] double to_u(double s) const { return interpolate(s_, u_, s); }
+  [[nodiscard]] double to_s(double u) const { return interpolate(u_, s_, u); }
+
+ private:
+  static double interpolate(const std::vector<double>& x, const std::vector<double>& y, double at) {
+    auto it = std::upper_bound(x.begin(), x.end(), at);
+    if (it == x.begin()) return y.front() + (at - x.front());
+    if (it == x.end()) return y.back() + (at - x.back());
+    const std::size_t k = static_cast<std::size_t>(it - x.begin());
+    const double span = x[k] - x[k - 1];
+    return span > 0.0 ? y[k - 1] + (y[k] - y[k - 1]) * (at - x[k - 1]) / span : y[k];
+  }
+  std::vector<double> s_, u_;
+};
+
 // Takes out of the path every loop (a node it comes back to) that the vehicle did not drive. Where
 // fixes scatter over a small roundabout, or over both ways of a road at a stop, the most likely
 // sequence of edges may run once more round the loop: each move round it is only a few σ longer
@@ -193,7 +271,11 @@ std::vector<MatchedPoint> smooth_along_path(const maps::RoadGraph& g, planner::B
     last = i;
   }
 
-  // 2. Constant-velocity Kalman filter over (s, v), then the RTS smoother.
+  // 2. Constant-velocity Kalman filter over (u, v), the driven distance, then the RTS smoother.
+  const DrivenCoordinate driven(g, path, config.corner_radius_m, g.left_hand_traffic() ? -config.lane_offset_m : config.lane_offset_m);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!std::isnan(s[i])) s[i] = driven.to_u(s[i]);
+  }
   using Vec = std::array<double, 2>;
   using Mat = std::array<double, 4>;  // row-major 2×2
   std::vector<Vec> xf(n), xp(n);
@@ -258,7 +340,7 @@ std::vector<MatchedPoint> smooth_along_path(const maps::RoadGraph& g, planner::B
   // 3. Back onto the path.
   const double s_end = path.back().s_start + g.length_m(path.back().edge);
   for (std::size_t i = 0; i < n; ++i) {
-    const double at = std::clamp(xs[i][0], 0.0, s_end);
+    const double at = std::clamp(driven.to_s(xs[i][0]), 0.0, s_end);
     auto it = std::upper_bound(path.begin(), path.end(), at, [](double v, const Occurrence& o) { return v < o.s_start; });
     const Occurrence& o = it == path.begin() ? path.front() : *std::prev(it);
     out[i].edge = o.edge;

@@ -9,6 +9,9 @@
 // scattered over a small roundabout) is taken out, and its fixes put on the road into or out of it;
 // and the chain is smoothed in parts where the path between two points is far longer than the
 // fixes moved, or than the speeds say was driven (a detour round a road the graph lacks).
+// The filter runs on the distance the vehicle drove, which the speeds measure: a vehicle rounds
+// corners and keeps to its side of the road, so it drives less than the centre lines through a
+// right turn (where traffic keeps right) and more through a left one.
 #pragma once
 
 #include <span>
@@ -26,6 +29,12 @@ struct SmootherConfig {
   double sigma_base_m = 4.0;         // position σ = HDOP × this, as the matcher's emission
   double default_hdop = 1.5;
   double speed_gap_s = 30.0;         // the speeds say nothing of the distance driven over longer gaps
+  // The distance driven is not the distance along the centre lines (DrivenCoordinate in the .cpp):
+  // a vehicle rounds a corner on an arc of this radius (less where the road's pieces are short)...
+  double corner_radius_m = 8.0;
+  // ...and keeps this far to its side of a two-way road's centre line (half a 3.5 m lane; the left
+  // side where the graph says traffic keeps left). 0 and 0: the centre lines.
+  double lane_offset_m = 1.75;
 };
 
 // `points` is one unbroken chain matched from `fixes` (same length, first and last matched).

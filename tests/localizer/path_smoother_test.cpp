@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 
@@ -227,6 +228,77 @@ TEST(PathSmoother, SplitsTheChainAtAMoveTheSpeedsSayWasADetour) {
     EXPECT_NEAR(out[i].point.x_m, 100.0 + 10.0 * static_cast<double>(i), 3.0) << i;
     EXPECT_NEAR(out[i].point.y_m, 0.0, 0.5) << i;
   }
+}
+
+// A two-way road east to B (300, 0), then a 90° turn onto one that runs on south (right where
+// traffic keeps right) or north (left). A vehicle at 10 m/s rounds the corner on an 8 m arc 1.75 m
+// to its side of the centre lines: through a right turn it drives 2·8 − 8·π/2 + 1.75·π/2 = 6.18 m
+// less than the centre lines, through a left one 2·8 − 8·π/2 − 1.75·π/2 = 0.68 m less. Its speeds
+// say so; its fixes (HDOP 4, σ 16 m, and so only loosely held) lie on the centre lines. Smoothed
+// on the centre lines, the speeds' 6 m disagree with the fixes and pull the track off them round
+// the corner; on the distance driven they agree.
+maps::RoadGraph corner(double turn_sign, bool left_hand_traffic) {
+  Sketch sk;
+  sk.nodes = {{0, 0}, {300, 0}, {300, -300 * turn_sign}};
+  sk.roads = {{{0, 1, 2}, false, 1}};
+  maps::RoadGraphData data = sk.build().data();
+  if (left_hand_traffic) data.left_hand_traffic = {1};
+  return maps::RoadGraph(std::move(data));
+}
+
+struct Corner {
+  maps::RoadGraph g;
+  std::vector<GpsFix> fixes;
+  std::vector<MatchedPoint> points;
+  std::vector<double> s;  // the truth, along the centre lines
+  EdgeId first, second;
+
+  Corner(double turn_sign, bool left_hand_traffic) : g(corner(turn_sign, left_hand_traffic)) {
+    first = edge_between(g, {0, 0}, {300, 0});
+    second = edge_between(g, {300, 0}, {300, -300 * turn_sign});
+    const bool shorter_side = (turn_sign > 0) != left_hand_traffic;  // turning to the side traffic keeps to
+    const double saved = 16.0 - 8.0 * M_PI / 2.0 + (shorter_side ? 1.75 : -1.75) * M_PI / 2.0;
+    for (int i = 0; i < 50; ++i) {
+      const double driven = 100.0 + 10.0 * i;
+      // Along the centre lines: the corner's saving spread over its arc, 8 m either side of B.
+      const double along = driven + saved * std::clamp((driven - (300.0 - 8.0)) / (16.0 - saved), 0.0, 1.0);
+      s.push_back(along);
+      MatchedPoint m;
+      m.matched = true;
+      m.edge = along <= 300.0 ? first : second;
+      m.offset_m = along <= 300.0 ? along : along - 300.0;
+      m.point = g.point_along(m.edge, m.offset_m);
+      points.push_back(m);
+      fixes.push_back({static_cast<double>(i), g.projection().to_lat_lon(m.point), 4.0, std::nullopt, 10.0});
+    }
+  }
+  // The largest distance between a smoothed point and the truth, along the centre lines.
+  double worst(const SmootherConfig& config) {
+    planner::BoundedDistances distances{g.node_count()};
+    const auto out = smooth_along_path(g, distances, fixes, points, config);
+    double worst_m = 0.0;
+    for (std::size_t i = 0; i < out.size(); ++i) {
+      const double along = out[i].edge == first ? out[i].offset_m : 300.0 + out[i].offset_m;
+      worst_m = std::max(worst_m, std::abs(along - s[i]));
+    }
+    return worst_m;
+  }
+};
+
+TEST(PathSmoother, TheSpeedsMeasureTheDistanceDrivenRoundACorner) {
+  SmootherConfig centre_lines;
+  centre_lines.corner_radius_m = 0.0;
+  centre_lines.lane_offset_m = 0.0;
+  Corner right(1.0, false);
+  EXPECT_GT(right.worst(centre_lines), 1.5);
+  EXPECT_LT(right.worst({}), 0.3);
+  // Turning away from the side traffic keeps to, the vehicle drives the outside of the corner.
+  Corner left(-1.0, false);
+  EXPECT_LT(left.worst({}), 0.3);
+  // Where traffic keeps left, a left turn is the short one.
+  Corner left_in_left_hand_traffic(-1.0, true);
+  EXPECT_LT(left_in_left_hand_traffic.worst({}), 0.3);
+  EXPECT_GT(left_in_left_hand_traffic.worst(centre_lines), 1.5);
 }
 
 }  // namespace
