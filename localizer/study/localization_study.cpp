@@ -32,6 +32,21 @@ std::pair<EdgeId, double> nearest_agreeing(const maps::RoadGraph& g, const std::
 
 constexpr auto kAnyEdge = [](EdgeId) { return true; };
 
+// Whether p lies more than margin_m beyond edge e's head or before its tail, along the road (its
+// first and last pieces), rather than beside it.
+bool beyond_ends(const maps::RoadGraph& g, EdgeId e, maps::Point2 p, double margin_m) {
+  const auto pts = g.geometry(e);
+  if (pts.size() < 2) return false;
+  auto along = [&](maps::Point2 from, maps::Point2 to) {  // p's coordinate along from → to, from `from`
+    const double dx = to.x_m - from.x_m, dy = to.y_m - from.y_m, len = std::hypot(dx, dy);
+    return len > 0.0 ? ((p.x_m - from.x_m) * dx + (p.y_m - from.y_m) * dy) / len : 0.0;
+  };
+  const std::size_t n = pts.size();
+  const maps::Point2 head = pts[n - 1];
+  const maps::Point2 past_head{2.0 * head.x_m - pts[n - 2].x_m, 2.0 * head.y_m - pts[n - 2].y_m};
+  return along(head, past_head) > margin_m || along(pts[0], pts[1]) < -margin_m;
+}
+
 // The farthest apart that SUMO's junction joining puts OSM nodes of one junction
 // (netconvert --junctions.join-dist is 10 m; clusters chain a few of them), beyond the distance
 // the vehicle drove through it.
@@ -101,9 +116,11 @@ std::vector<TrueEdges> true_edges(const maps::RoadGraph& g, const maps::EdgeSnap
     // ...unless the lane's way has an edge here: its nearest, if not well beyond that road.
     // netconvert joins consecutive ways into one edge (--geometry.remove), and its lane then
     // names only the way where that edge starts.
+    // A vehicle beyond the ends of every edge of the way along the road has driven on past where
+    // the way ends: onto the way netconvert joined to it, whose edge is then the nearest road.
     if (way) {
       const auto on_way = nearest_agreeing(g, candidates, s.heading_deg, 90.0, nearest_d + 4.0,
-                                           [&](EdgeId e) { return g.osm_way(e).v == *way; });
+                                           [&](EdgeId e) { return g.osm_way(e).v == *way && !beyond_ends(g, e, p, 1.0); });
       if (on_way.first.valid()) out[i].edge = on_way.first, out[i].from_lane = true;
     }
   }

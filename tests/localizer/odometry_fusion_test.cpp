@@ -500,6 +500,21 @@ TEST(LocalizationStudy, TrueEdgesFollowTheLaneWayAndSpanAJunction) {
 
 // SUMO drives some ways our importer leaves out (a street closed to motor vehicles): a sample on
 // such a way's lane has no true edge, though one of our roads runs 4 m from it.
+// netconvert joins way 1 and way 2, which meet end to end with no junction, into one edge whose lane
+// names way 1 only. A vehicle on that lane 3 m past the node has driven onto way 2, though way 1's
+// end lies within 4 m; one 0.5 m short of the node is still on way 1.
+TEST(LocalizationStudy, ALanePastItsWaysEndIsOnTheWayJoinedToIt) {
+  Sketch s;
+  s.nodes = {{-300, 0}, {0, 0}, {300, 0}};
+  s.roads = {{{0, 1}, false, 1}, {{1, 2}, false, 2}};
+  const auto g = s.build();
+  const maps::EdgeSnapper snapper(g);
+  const std::vector<TruthSample> drive = {eastward_sample(g, 3, 1.6, "1_0"), eastward_sample(g, -0.5, 1.6, "1_0")};
+  const auto truth = true_edges(g, snapper, drive, 20.0);
+  EXPECT_EQ(truth[0].edge, edge_between(g, {0, 0}, {300, 0}));
+  EXPECT_EQ(truth[1].edge, edge_between(g, {-300, 0}, {0, 0}));
+}
+
 TEST(LocalizationStudy, ALaneOnAWayTheGraphLacksHasNoTrueEdge) {
   Sketch s;
   s.nodes = {{-300, 0}, {300, 0}};
