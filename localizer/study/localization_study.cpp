@@ -33,18 +33,17 @@ std::pair<EdgeId, double> nearest_agreeing(const maps::RoadGraph& g, const std::
 constexpr auto kAnyEdge = [](EdgeId) { return true; };
 
 // Whether p lies more than margin_m beyond edge e's head or before its tail, along the road (its
-// first and last pieces), rather than beside it.
+// nearest point on the edge is an end, and p lies past it along the end piece), rather than beside it.
 bool beyond_ends(const maps::RoadGraph& g, EdgeId e, maps::Point2 p, double margin_m) {
   const auto pts = g.geometry(e);
   if (pts.size() < 2) return false;
-  auto along = [&](maps::Point2 from, maps::Point2 to) {  // p's coordinate along from → to, from `from`
-    const double dx = to.x_m - from.x_m, dy = to.y_m - from.y_m, len = std::hypot(dx, dy);
-    return len > 0.0 ? ((p.x_m - from.x_m) * dx + (p.y_m - from.y_m) * dy) / len : 0.0;
-  };
-  const std::size_t n = pts.size();
-  const maps::Point2 head = pts[n - 1];
-  const maps::Point2 past_head{2.0 * head.x_m - pts[n - 2].x_m, 2.0 * head.y_m - pts[n - 2].y_m};
-  return along(head, past_head) > margin_m || along(pts[0], pts[1]) < -margin_m;
+  const maps::RoadGraph::EdgePoint nearest = g.nearest_point(e, p);
+  const bool at_tail = nearest.offset_m <= 1e-6, at_head = nearest.offset_m >= g.length_m(e) - 1e-6;
+  if (!at_tail && !at_head) return false;
+  const maps::Point2 end = at_head ? pts[pts.size() - 1] : pts[0];
+  const maps::Point2 inner = at_head ? pts[pts.size() - 2] : pts[1];
+  const double dx = end.x_m - inner.x_m, dy = end.y_m - inner.y_m, len = std::hypot(dx, dy);
+  return len > 0.0 && ((p.x_m - end.x_m) * dx + (p.y_m - end.y_m) * dy) / len > margin_m;
 }
 
 // The farthest apart that SUMO's junction joining puts OSM nodes of one junction

@@ -515,6 +515,40 @@ TEST(LocalizationStudy, ALanePastItsWaysEndIsOnTheWayJoinedToIt) {
   EXPECT_EQ(truth[1].edge, edge_between(g, {-300, 0}, {0, 0}));
 }
 
+// A way that bends back on itself (a hairpin) has no end near a sample half-way round, though the
+// sample lies behind its first piece: its lane still names it, with a tunnel 1 m below it nearer.
+TEST(LocalizationStudy, AHairpinsLaneIsOnItsWayAllTheWayRound) {
+  maps::GraphBuildInput in;
+  in.origin = {47.0, 9.5};
+  in.node_pos = {{0, 0}, {-50, 20}, {20, 21}, {-60, 21}};
+  for (std::uint32_t i = 0; i < 4; ++i) {
+    in.node_osm.push_back(OsmNodeId{i + 1});
+    in.node_signalized.push_back(0);
+  }
+  auto road = [&](std::uint32_t from, std::uint32_t to, std::vector<maps::Point2> points, std::int64_t way) {
+    maps::RoadSegment seg;
+    seg.from = from;
+    seg.to = to;
+    seg.first_point = static_cast<std::uint32_t>(in.points.size());
+    in.points.insert(in.points.end(), points.begin(), points.end());
+    seg.last_point = static_cast<std::uint32_t>(in.points.size() - 1);
+    seg.forward = true;
+    seg.forward_speed_mps = seg.backward_speed_mps = 14.0f;
+    seg.way = OsmWayId{way};
+    seg.road_class = maps::RoadClass::residential;
+    in.segments.push_back(seg);
+  };
+  road(0, 1, {{0, 0}, {100, 0}, {100, 20}, {-50, 20}}, 1);  // east, round, and back west
+  road(2, 3, {{20, 21}, {-60, 21}}, 2);                      // the tunnel, west
+  const maps::RoadGraph g = maps::build_road_graph(in);
+  const maps::EdgeSnapper snapper(g);
+  TruthSample t = eastward_sample(g, -30, 20.6, "1_0");
+  t.heading_deg = 270.0;
+  const auto truth = true_edges(g, snapper, {t}, 20.0);
+  ASSERT_TRUE(truth[0].edge.valid());
+  EXPECT_EQ(g.osm_way(truth[0].edge).v, 1);
+}
+
 TEST(LocalizationStudy, ALaneOnAWayTheGraphLacksHasNoTrueEdge) {
   Sketch s;
   s.nodes = {{-300, 0}, {300, 0}};
