@@ -262,8 +262,25 @@ std::vector<MatchedPoint> smooth_along_path(const maps::RoadGraph& g, planner::B
     if (std::abs(s[i] - s[last]) > 2.0 * moved + 10.0 * dt || detour) {
       auto head = smooth_along_path(g, distances, fixes.first(last + 1), points.first(last + 1), config);
       const auto tail = smooth_along_path(g, distances, fixes.subspan(i), points.subspan(i), config);
-      // Points set aside between the two parts keep no estimate (the path between is in doubt).
-      head.insert(head.end(), points.begin() + static_cast<std::ptrdiff_t>(last + 1), points.begin() + static_cast<std::ptrdiff_t>(i));
+      // The path between the two parts is in doubt, but the vehicle was somewhere between the
+      // edge one ends on and the edge the other starts on: a fix set aside between them goes to the
+      // nearer of the two where it lies within 3σ of it (a turn through a junction our graph draws
+      // elsewhere, where SUMO's vehicle cut across); further off, it keeps no estimate.
+      const EdgeId before_gap = head.back().edge, after_gap = tail.front().edge;
+      for (std::size_t k = last + 1; k < i; ++k) {
+        MatchedPoint m = points[k];
+        const maps::Point2 raw = g.projection().to_local(fixes[k].position);
+        const auto a = g.nearest_point(before_gap, raw), b = g.nearest_point(after_gap, raw);
+        const bool to_before = a.distance_m <= b.distance_m;
+        const maps::RoadGraph::EdgePoint& at = to_before ? a : b;
+        if (at.distance_m <= 3.0 * sigma_of(fixes[k])) {
+          m.matched = true;
+          m.edge = to_before ? before_gap : after_gap;
+          m.offset_m = at.offset_m;
+          m.point = at.point;
+        }
+        head.push_back(m);
+      }
       head.insert(head.end(), tail.begin(), tail.end());
       return head;
     }

@@ -230,6 +230,40 @@ TEST(PathSmoother, SplitsTheChainAtAMoveTheSpeedsSayWasADetour) {
   }
 }
 
+// The same split, with the gap's fixes: the vehicle was somewhere between the edge the first part
+// ends on and the edge the second starts on, so a fix set aside in the gap goes to the nearer of
+// the two; one 40 m off the road (10σ) keeps no estimate.
+TEST(PathSmoother, AFixInTheGapOfASplitChainGoesToTheNearerEdgeAroundIt) {
+  const maps::RoadGraph g = [] {
+    Sketch s;
+    s.nodes = {{0, 0}, {300, 0}, {310, 30}, {320, 0}, {700, 0}};
+    s.roads = {{{0, 1}, true, 1}, {{1, 2, 3}, true, 2}, {{3, 4}, true, 3}};
+    return s.build();
+  }();
+  planner::BoundedDistances distances{g.node_count()};
+  const EdgeId west = edge_between(g, {0, 0}, {300, 0}), east = edge_between(g, {320, 0}, {700, 0});
+  std::vector<GpsFix> fixes;
+  std::vector<MatchedPoint> points;
+  for (int i = 0; i < 40; ++i) {
+    const double x = 100.0 + 10.0 * i;
+    const double y = x == 320.0 ? 40.0 : 0.0;  // the second fix in the gap is a multipath one
+    fixes.push_back({static_cast<double>(i), g.projection().to_lat_lon({x - (x == 310.0 ? 7.0 : 0.0), y}), 1.0, 90.0, 10.0});
+    MatchedPoint m;
+    if (x <= 300.0 || x >= 330.0) {
+      m.matched = true;
+      m.edge = x <= 300.0 ? west : east;
+      m.offset_m = x <= 300.0 ? x : x - 320.0;
+      m.point = {x, 0};
+    }
+    points.push_back(m);
+  }
+  const auto out = smooth_along_path(g, distances, fixes, points);
+  ASSERT_TRUE(out[21].matched);  // x = 303, 3 m past the west edge's end, 17 m before the east one
+  EXPECT_EQ(out[21].edge, west);
+  EXPECT_NEAR(out[21].offset_m, 300.0, 0.5);
+  EXPECT_FALSE(out[22].matched);
+}
+
 // A two-way road east to B (300, 0), then a 90° turn onto one that runs on south (right where
 // traffic keeps right) or north (left). A vehicle at 10 m/s rounds the corner on an 8 m arc 1.75 m
 // to its side of the centre lines: through a right turn it drives 2·8 − 8·π/2 + 1.75·π/2 = 6.18 m
