@@ -1,5 +1,7 @@
 #include "localizer/match/path_smoother.hpp"
 
+#include "localizer/match/corner_cut.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -37,7 +39,7 @@ double driven_m(std::span<const GpsFix> fixes, std::size_t a, std::size_t b, dou
 // spread over the arc), increasing, and inverted by bisection over its breakpoints.
 class DrivenCoordinate {
  public:
-  DrivenCoordinate(const maps::RoadGraph& g, const std::vector<Occurrence>& path, double corner_radius_m, double lane_offset_m) {
+  DrivenCoordinate(const maps::RoadGraph& g, const std::vector<Occurrence>& path, const CornerModel& corner) {
     struct Vertex {
       maps::Point2 p;
       double s;
@@ -49,7 +51,7 @@ class DrivenCoordinate {
       double geometric = 0.0;
       for (std::size_t i = 1; i < pts.size(); ++i) geometric += maps::distance_m(pts[i - 1], pts[i]);
       const double scale = geometric > 0.0 ? g.length_m(o.edge) / geometric : 1.0;
-      const double offset = g.twin(o.edge).valid() ? lane_offset_m : 0.0;
+      const double offset = g.twin(o.edge).valid() ? corner.lane_offset_m : 0.0;
       double at = o.s_start;
       if (v.empty()) v.push_back({pts.front(), at, offset});
       for (std::size_t i = 1; i < pts.size(); ++i) {
@@ -63,34 +65,34 @@ class DrivenCoordinate {
     };
     std::vector<Ramp> ramps;
     for (std::size_t j = 1; j + 1 < v.size(); ++j) {
-      const double ax = v[j].p.x_m - v[j - 1].p.x_m, ay = v[j].p.y_m - v[j - 1].p.y_m;
-      const double bx = v[j + 1].p.x_m - v[j].p.x_m, by = v[j + 1].p.y_m - v[j].p.y_m;
-      double theta = -std::atan2(ax * by - ay * bx, ax * bx + ay * by);  // right turns positive
-      theta = std::clamp(theta, -2.6, 2.6);  // no tighter than 150°
-      const double abs_theta = std::abs(theta);
-      if (abs_theta < 1e-3) continue;
-      const double a = v[j].s - v[j - 1].s, b = v[j + 1].s - v[j].s;
-      const double tan_half = std::tan(0.5 * abs_theta);
-      const double r = std::min(corner_radius_m, 0.5 * std::min(a, b) / tan_half);
-      const double tangent = r * tan_half;
-      const double d = 0.5 * (v[j].offset + v[j + 1].offset);
-      const double delta = 2.0 * tangent - r * abs_theta + d * theta;
-      const double w = std::max({tangent, std::abs(delta), 0.5});
-      ramps.push_back({v[j].s - w, v[j].s + w, delta});
+      const double theta = turn_towards_traffic_side_rad(g, v[j].p.x_m - v[j - 1].p.x_m, v[j].p.y_m - v[j - 1].p.y_m,
+                                                         v[j + 1].p.x_m - v[j].p.x_m, v[j + 1].p.y_m - v[j].p.y_m);
+      const CornerCut cut = corner_cut(theta, v[j].s - v[j - 1].s, v[j + 1].s - v[j].s, corner.radius_m,
+                                       0.5 * (v[j].offset + v[j + 1].offset));
+      if (cut.saving_m == 0.0) continue;
+      ramps.push_back({v[j].s - cut.half_width_m, v[j].s + cut.half_width_m, cut.saving_m});
     }
-    std::vector<double> at;
-    at.push_back(path.front().s_start - 1e6);
-    for (const Ramp& r : ramps) at.push_back(r.from), at.push_back(r.to);
-    at.push_back(path.back().s_start + g.length_m(path.back().edge) + 1e6);
-    std::sort(at.begin(), at.end());
-    s_ = at;
-    u_.resize(at.size());
-    for (std::size_t k = 0; k < at.size(); ++k) {
-      double u = at[k];
-      for (const Ramp& r : ramps) u -= r.delta * std::clamp((at[k] - r.from) / (r.to - r.from), 0.0, 1.0);
-      if (k > 0) u = std::max(u, u_[k - 1] + 0.05 * (at[k] - at[k - 1]));
-      u_[k] = u;
+    // u falls behind s by each ramp's share as the ramps pass: a sweep over their ends, each piece
+    // between two ends linear with slope 1 minus the ramps under it (kept above 0.05, increasing).
+    std::vector<std::pair<double, double>> ends;  // (s, change of the falling slope there)
+    for (const Ramp& r : ramps) {
+      const double slope = r.delta / (r.to - r.from);
+      ends.emplace_back(r.from, slope), ends.emplace_back(r.to, -slope);
     }
+    std::sort(ends.begin(), ends.end());
+    s_.assign(1, path.front().s_start - 1e6);
+    u_.assign(1, s_.front());
+    double falling = 0.0;
+    for (const auto& [at, change] : ends) {
+      if (at > s_.back()) {
+        u_.push_back(u_.back() + (at - s_.back()) * std::max(0.05, 1.0 - falling));
+        s_.push_back(at);
+      }
+      falling += change;
+    }
+    const double end = path.back().s_start + g.length_m(path.back().edge) + 1e6;
+    u_.push_back(u_.back() + (end - s_.back()) * std::max(0.05, 1.0 - falling));
+    s_.push_back(end);
   }
   [[nodiscard]] double to_u(double s) const { return interpolate(s_, u_, s); }
   [[nodiscard]] double to_s(double u) const { return interpolate(u_, s_, u); }
@@ -289,7 +291,7 @@ std::vector<MatchedPoint> smooth_along_path(const maps::RoadGraph& g, planner::B
   }
 
   // 2. Constant-velocity Kalman filter over (u, v), the driven distance, then the RTS smoother.
-  const DrivenCoordinate driven(g, path, config.corner_radius_m, g.left_hand_traffic() ? -config.lane_offset_m : config.lane_offset_m);
+  const DrivenCoordinate driven(g, path, config.corner);
   for (std::size_t i = 0; i < n; ++i) {
     if (!std::isnan(s[i])) s[i] = driven.to_u(s[i]);
   }

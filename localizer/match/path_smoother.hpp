@@ -17,6 +17,7 @@
 #include <span>
 #include <vector>
 
+#include "localizer/match/corner_cut.hpp"
 #include "localizer/match/gps_fix.hpp"
 #include "maps/road_graph.hpp"
 #include "planner/bounded_search.hpp"
@@ -29,12 +30,9 @@ struct SmootherConfig {
   double sigma_base_m = 4.0;         // position σ = HDOP × this, as the matcher's emission
   double default_hdop = 1.5;
   double speed_gap_s = 30.0;         // the speeds say nothing of the distance driven over longer gaps
-  // The distance driven is not the distance along the centre lines (DrivenCoordinate in the .cpp):
-  // a vehicle rounds a corner on an arc of this radius (less where the road's pieces are short)...
-  double corner_radius_m = 8.0;
-  // ...and keeps this far to its side of a two-way road's centre line (half a 3.5 m lane; the left
-  // side where the graph says traffic keeps left). 0 and 0: the centre lines.
-  double lane_offset_m = 1.75;
+  // The distance driven is not the distance along the centre lines (corner_cut.hpp; radius 0 and
+  // offset 0: the centre lines).
+  CornerModel corner;
 };
 
 // `points` is one unbroken chain matched from `fixes` (same length, first and last matched).

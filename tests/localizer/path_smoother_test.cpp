@@ -321,8 +321,7 @@ struct Corner {
 
 TEST(PathSmoother, TheSpeedsMeasureTheDistanceDrivenRoundACorner) {
   SmootherConfig centre_lines;
-  centre_lines.corner_radius_m = 0.0;
-  centre_lines.lane_offset_m = 0.0;
+  centre_lines.corner = {0.0, 0.0};
   Corner right(1.0, false);
   EXPECT_GT(right.worst(centre_lines), 1.5);
   EXPECT_LT(right.worst({}), 0.3);
