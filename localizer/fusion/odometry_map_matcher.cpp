@@ -1,5 +1,7 @@
 #include "localizer/fusion/odometry_map_matcher.hpp"
 
+#include "localizer/match/corner_cut.hpp"
+
 #include "localizer/match/bearing.hpp"
 
 #include <algorithm>
@@ -132,6 +134,8 @@ void OdometryMapMatcher::move(Hypothesis h, double left_m, std::vector<Hypothesi
     const NodeId junction = graph_.head(f.h.edge);
     const EdgeId back = graph_.twin(f.h.edge);
     const double bearing_in = road_bearing_deg(f.h.edge, len);
+    const auto in_pts = graph_.geometry(f.h.edge);
+    const maps::Point2 in_a = in_pts[in_pts.size() - 2], in_b = in_pts.back();
     bool any = false;
     for (int pass = 0; pass < 2 && !any; ++pass) {
       for (EdgeId e : graph_.out_edges(junction)) {
@@ -140,13 +144,24 @@ void OdometryMapMatcher::move(Hypothesis h, double left_m, std::vector<Hypothesi
         next.edge = e;
         next.offset_m = 0.0;
         next.junction_s = driven_m_ - rest;
+        // The odometry measures the arc the vehicle drove round the corner, on its side of the
+        // road; the hypothesis moves along the centre lines, which are longer through a turn
+        // towards that side (corner_cut.hpp).
+        const auto out_pts = graph_.geometry(e);
+        const double theta = turn_towards_traffic_side_rad(graph_, in_b.x_m - in_a.x_m, in_b.y_m - in_a.y_m,
+                                                           out_pts[1].x_m - out_pts[0].x_m, out_pts[1].y_m - out_pts[0].y_m);
+        const double offset = 0.5 * ((back.valid() ? config_.corner.lane_offset_m : 0.0) +
+                                     (graph_.twin(e).valid() ? config_.corner.lane_offset_m : 0.0));
+        const double saving = e == back ? 0.0
+                                        : corner_cut(theta, maps::distance_m(in_a, in_b), maps::distance_m(out_pts[0], out_pts[1]),
+                                                     config_.corner.radius_m, offset).saving_m;
         const double road_turn = wrap180(road_bearing_deg(e, 0.0) - bearing_in);
         if (std::abs(road_turn) > config_.reset_turn_deg) {
           next.sharp_s = next.junction_s;
           next.sharp_turn_deg = road_turn;
           next.sharp_pending = true;
         }
-        stack.push_back({next, rest, f.junctions + 1});
+        stack.push_back({next, std::max(0.0, rest + saving), f.junctions + 1});
         any = true;
       }
     }

@@ -26,6 +26,7 @@
 #include <optional>
 #include <vector>
 
+#include "localizer/match/corner_cut.hpp"
 #include "localizer/match/gps_fix.hpp"
 #include "maps/edge_snapper.hpp"
 #include "maps/road_graph.hpp"
@@ -79,6 +80,9 @@ struct OdometryMatchConfig {
   // docs/experiments/localization.md).
   double junction_commit_m = 2.0;
   double slow_speed_mps = 4.0;
+  // Through a junction the odometry measures the arc driven, the hypotheses move along the centre
+  // lines (corner_cut.hpp; radius 0 and offset 0: the centre lines).
+  CornerModel corner;
 };
 
 // Where the odometry starts: the last good fix, matched.
