@@ -262,11 +262,15 @@ LocalizedPoint GpsOdometryLocalizer::on_odometry(const OdometryStep& reported) {
     driven_since_course_m_ += std::max(0.0, step.distance_m);
   }
   if (!odometry_.started()) return last_;
-  // Recorded from the last good fix on (each fix restarts it), so that when GPS goes quiet the
-  // odometry already holds every metre driven since; it is the output only after the timeout.
+  // Driven from the last good fix on (each fix restarts it), so that when GPS goes quiet the
+  // odometry already holds every metre driven since; it is the output on its own after the timeout.
   if (step.time_s - last_good_gps_s_ <= takeover_s_) {
-    odometry_.record(step);
-    return last_;
+    // Between two fixes the last one is carried on by the odometry (the hypotheses it started
+    // from that fix), not held: a 1 Hz receiver's fix is up to a second old, 30 m at 30 m/s. It
+    // is still GPS's position, dead-reckoned for less than the takeover time.
+    const MatchedPoint m = odometry_.advance(step);
+    if (!m.matched || !(step.time_s > last_good_gps_s_) || last_.source != PositionSource::gps) return last_;
+    return output(PositionSource::gps, m, std::max(last_.sigma_m, odometry_.sigma_m()));
   }
   const MatchedPoint m = odometry_.advance(step);
   return output(PositionSource::odometry, m, odometry_.sigma_m());

@@ -1,7 +1,8 @@
 // The localizer's one entry point per sensor: GPS fixes and odometry increments in, positions on
 // the road graph out. As in the seed, GPS is followed while its HDOP is at most 10, through the
 // online HMM matcher; when the HDOP is worse or fixes stop coming, odometry takes over from the
-// last good fixes and heading and is kept on the map (OdometryMapMatcher). It restarts at every
+// last good fixes and heading and is kept on the map (OdometryMapMatcher). Between two good fixes
+// the last one is carried on by the odometry rather than held. The odometry restarts at every
 // good fix from where the recent fixes, carried by the odometry, put the vehicle; a fix that
 // disagrees with them (multipath) is shown but not restarted from. Handing over to odometry
 // continues from there, so the position does not jump beyond the last fix's own error; handing

@@ -499,6 +499,29 @@ TEST_F(LocalizerOnCrossroads, AnOverdueFixHandsOverToTheOdometrySoonerThanTheTim
   EXPECT_NEAR(p.match.point.x_m, x + 20.0, 3.0);
 }
 
+// A 1 Hz receiver and a 10 Hz odometry: between two fixes the position moves on with the
+// odometry from the last fix (still GPS's, dead-reckoned), instead of standing at it.
+TEST_F(LocalizerOnCrossroads, BetweenFixesTheLastFixIsCarriedOnByTheOdometry) {
+  double x = -250.0;
+  for (int k = 0; k <= 50; ++k) {
+    const double t = 0.1 * k;
+    if (k > 0) {
+      x += 1.0;
+      p = loc.on_odometry({t, 1.0, 0.0});
+    }
+    if (k % 10 == 0) {
+      GpsFix f = fix_at(g, t, x, 1.0);
+      f.heading_deg = 90.0;
+      f.speed_mps = 10.0;
+      p = loc.on_gps(f);
+    }
+  }
+  ASSERT_EQ(p.source, PositionSource::gps);  // the fix at t = 5 s, x = -200
+  for (int k = 51; k <= 57; ++k) p = loc.on_odometry({0.1 * k, 1.0, 0.0});
+  EXPECT_EQ(p.source, PositionSource::gps);
+  EXPECT_NEAR(p.match.point.x_m, x + 7.0, 1.5);
+}
+
 TEST(LocalizationStudy, ReadsTheOsmWayOfASumoLane) {
   EXPECT_EQ(sumo_lane_osm_way("93209286#3_0"), 93209286);
   EXPECT_EQ(sumo_lane_osm_way("-93209286#12_1"), 93209286);
