@@ -31,6 +31,10 @@ class LocalizerOnCrossroads : public ::testing::Test {
   maps::EdgeSnapper snapper{g};
   GpsOdometryLocalizer loc{g, snapper};
   LocalizedPoint p;
+
+  // Drives east from 250 m west of the junction at 10 m/s for `seconds`: odometry at 10 Hz, a
+  // fix a second (course and speed given). Returns where the vehicle is.
+  double drive_east(int seconds);
 };
 
 // A fix 1 m north of the east-west road, at x metres east of the crossroads.
@@ -40,6 +44,24 @@ GpsFix fix_at(const maps::RoadGraph& g, double t, double x, std::optional<double
   f.position = g.projection().to_lat_lon({x, 1.0});
   f.hdop = hdop;
   return f;
+}
+
+double LocalizerOnCrossroads::drive_east(int seconds) {
+  double x = -250.0;
+  for (int k = 0; k <= 10 * seconds; ++k) {
+    const double t = 0.1 * k;
+    if (k > 0) {
+      x += 1.0;
+      p = loc.on_odometry({t, 1.0, 0.0});
+    }
+    if (k % 10 == 0) {
+      GpsFix f = fix_at(g, t, x, 1.0);
+      f.heading_deg = 90.0;
+      f.speed_mps = 10.0;
+      p = loc.on_gps(f);
+    }
+  }
+  return x;
 }
 
 // Drives 10 m a second from 150 m west of the junction, eastbound; `turn_deg` is spread over the
@@ -477,20 +499,7 @@ TEST_F(LocalizerOnCrossroads, AFastReceiversLatencyDoesNotHandOverBetweenItsFixe
 // and a half of the fixes' intervals have passed (not after the 2.5 s timeout): the position
 // moves on instead of standing at the last fix while the vehicle drives away from it.
 TEST_F(LocalizerOnCrossroads, AnOverdueFixHandsOverToTheOdometrySoonerThanTheTimeout) {
-  double x = -250.0;
-  for (int k = 0; k <= 100; ++k) {
-    const double t = 0.1 * k;
-    if (k > 0) {
-      x += 1.0;
-      p = loc.on_odometry({t, 1.0, 0.0});
-    }
-    if (k % 10 == 0) {
-      GpsFix f = fix_at(g, t, x, 1.0);
-      f.heading_deg = 90.0;
-      f.speed_mps = 10.0;
-      p = loc.on_gps(f);
-    }
-  }
+  const double x = drive_east(10);
   ASSERT_EQ(p.source, PositionSource::gps);  // the last fix, at t = 10 s
   for (int k = 101; k <= 114; ++k) p = loc.on_odometry({0.1 * k, 1.0, 0.0});
   EXPECT_EQ(p.source, PositionSource::gps) << "1.4 s after the fix: it may still come";
@@ -502,20 +511,7 @@ TEST_F(LocalizerOnCrossroads, AnOverdueFixHandsOverToTheOdometrySoonerThanTheTim
 // A 1 Hz receiver and a 10 Hz odometry: between two fixes the position moves on with the
 // odometry from the last fix (still GPS's, dead-reckoned), instead of standing at it.
 TEST_F(LocalizerOnCrossroads, BetweenFixesTheLastFixIsCarriedOnByTheOdometry) {
-  double x = -250.0;
-  for (int k = 0; k <= 50; ++k) {
-    const double t = 0.1 * k;
-    if (k > 0) {
-      x += 1.0;
-      p = loc.on_odometry({t, 1.0, 0.0});
-    }
-    if (k % 10 == 0) {
-      GpsFix f = fix_at(g, t, x, 1.0);
-      f.heading_deg = 90.0;
-      f.speed_mps = 10.0;
-      p = loc.on_gps(f);
-    }
-  }
+  const double x = drive_east(5);
   ASSERT_EQ(p.source, PositionSource::gps);  // the fix at t = 5 s, x = -200
   for (int k = 51; k <= 57; ++k) p = loc.on_odometry({0.1 * k, 1.0, 0.0});
   EXPECT_EQ(p.source, PositionSource::gps);

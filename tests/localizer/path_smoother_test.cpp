@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <optional>
 
 #include "tests/localizer/sketch_graph.hpp"
@@ -196,35 +197,44 @@ TEST(PathSmoother, ASpeedBeforeALongGapSaysNothingOfTheDistanceDriven) {
 
 // The road from the west ends at (300, 0) and goes on at (320, 0); our graph joins the two ends
 // only by a detour 63 m long through (310, 30) (SUMO's vehicle drove a link our importer left
-// out). Four fixes span the gap in 3 s, two set aside; the path between them is 73 m, the speeds
-// say 30, and the rule on the fixes' spacing alone (2 × 30 + 30 m) lets it through. Split there,
-// neither side is dragged along the detour.
-TEST(PathSmoother, SplitsTheChainAtAMoveTheSpeedsSayWasADetour) {
-  const maps::RoadGraph g = [] {
+// out). A fix a second at 10 m/s from x = 100 to 490; the two in the gap (x = 310 and 320) are set
+// aside, so four fixes span it in 3 s; the path between them is 73 m, the speeds say 30, and the
+// rule on the fixes' spacing alone (2 × 30 + 30 m) lets it through.
+struct DetourDrive {
+  maps::RoadGraph g = [] {
     Sketch s;
     s.nodes = {{0, 0}, {300, 0}, {310, 30}, {320, 0}, {700, 0}};
     s.roads = {{{0, 1}, true, 1}, {{1, 2, 3}, true, 2}, {{3, 4}, true, 3}};
     return s.build();
   }();
   planner::BoundedDistances distances{g.node_count()};
-  const EdgeId west = edge_between(g, {0, 0}, {300, 0}), east = edge_between(g, {320, 0}, {700, 0});
+  EdgeId west = edge_between(g, {0, 0}, {300, 0}), east = edge_between(g, {320, 0}, {700, 0});
   std::vector<GpsFix> fixes;
   std::vector<MatchedPoint> points;
-  for (int i = 0; i < 40; ++i) {
-    const double x = 100.0 + 10.0 * i;  // x = 100 … 490, 10 m/s
-    fixes.push_back({static_cast<double>(i), g.projection().to_lat_lon({x, 0}), 1.0, 90.0, 10.0});
-    MatchedPoint m;
-    if (x <= 300.0 || x >= 330.0) {  // the two in the gap are set aside
-      m.matched = true;
-      m.edge = x <= 300.0 ? west : east;
-      m.offset_m = x <= 300.0 ? x : x - 320.0;
-      m.point = {x, 0};
+
+  // `fix_at` says where the fix of the vehicle at x lies.
+  explicit DetourDrive(const std::function<maps::Point2(double)>& fix_at) {
+    for (int i = 0; i < 40; ++i) {
+      const double x = 100.0 + 10.0 * i;
+      fixes.push_back({static_cast<double>(i), g.projection().to_lat_lon(fix_at(x)), 1.0, 90.0, 10.0});
+      MatchedPoint m;
+      if (x <= 300.0 || x >= 330.0) {
+        m.matched = true;
+        m.edge = x <= 300.0 ? west : east;
+        m.offset_m = x <= 300.0 ? x : x - 320.0;
+        m.point = {x, 0};
+      }
+      points.push_back(m);
     }
-    points.push_back(m);
   }
-  const auto out = smooth_along_path(g, distances, fixes, points);
+};
+
+// Split at the detour, neither side is dragged along it.
+TEST(PathSmoother, SplitsTheChainAtAMoveTheSpeedsSayWasADetour) {
+  DetourDrive d([](double x) { return maps::Point2{x, 0}; });
+  const auto out = smooth_along_path(d.g, d.distances, d.fixes, d.points);
   for (std::size_t i = 0; i < out.size(); ++i) {
-    if (!points[i].matched) continue;
+    if (!d.points[i].matched) continue;
     EXPECT_NEAR(out[i].point.x_m, 100.0 + 10.0 * static_cast<double>(i), 3.0) << i;
     EXPECT_NEAR(out[i].point.y_m, 0.0, 0.5) << i;
   }
@@ -234,32 +244,13 @@ TEST(PathSmoother, SplitsTheChainAtAMoveTheSpeedsSayWasADetour) {
 // ends on and the edge the second starts on, so a fix set aside in the gap goes to the nearer of
 // the two; one 40 m off the road (10σ) keeps no estimate.
 TEST(PathSmoother, AFixInTheGapOfASplitChainGoesToTheNearerEdgeAroundIt) {
-  const maps::RoadGraph g = [] {
-    Sketch s;
-    s.nodes = {{0, 0}, {300, 0}, {310, 30}, {320, 0}, {700, 0}};
-    s.roads = {{{0, 1}, true, 1}, {{1, 2, 3}, true, 2}, {{3, 4}, true, 3}};
-    return s.build();
-  }();
-  planner::BoundedDistances distances{g.node_count()};
-  const EdgeId west = edge_between(g, {0, 0}, {300, 0}), east = edge_between(g, {320, 0}, {700, 0});
-  std::vector<GpsFix> fixes;
-  std::vector<MatchedPoint> points;
-  for (int i = 0; i < 40; ++i) {
-    const double x = 100.0 + 10.0 * i;
-    const double y = x == 320.0 ? 40.0 : 0.0;  // the second fix in the gap is a multipath one
-    fixes.push_back({static_cast<double>(i), g.projection().to_lat_lon({x - (x == 310.0 ? 7.0 : 0.0), y}), 1.0, 90.0, 10.0});
-    MatchedPoint m;
-    if (x <= 300.0 || x >= 330.0) {
-      m.matched = true;
-      m.edge = x <= 300.0 ? west : east;
-      m.offset_m = x <= 300.0 ? x : x - 320.0;
-      m.point = {x, 0};
-    }
-    points.push_back(m);
-  }
-  const auto out = smooth_along_path(g, distances, fixes, points);
+  DetourDrive d([](double x) {
+    if (x == 310.0) return maps::Point2{303.0, 0.0};
+    return maps::Point2{x, x == 320.0 ? 40.0 : 0.0};  // the second fix in the gap is a multipath one
+  });
+  const auto out = smooth_along_path(d.g, d.distances, d.fixes, d.points);
   ASSERT_TRUE(out[21].matched);  // x = 303, 3 m past the west edge's end, 17 m before the east one
-  EXPECT_EQ(out[21].edge, west);
+  EXPECT_EQ(out[21].edge, d.west);
   EXPECT_NEAR(out[21].offset_m, 300.0, 0.5);
   EXPECT_FALSE(out[22].matched);
 }
