@@ -93,6 +93,15 @@ void OdometryMapMatcher::seed() {
   const double matched_off = maps::distance_m(graph_.point_along(start_.edge, start_.offset_m), start_.point);
   add(start_.edge, start_.offset_m, matched_off);
   if (const EdgeId twin = graph_.twin(start_.edge); twin.valid()) add(twin, graph_.twin_offset_m(start_.edge, start_.offset_m), matched_off);
+  // The other exits of the node behind the match, as far past it: a fast vehicle a second past a
+  // fork whose branches part slowly may have its fixes' mean nearer the branch the online match
+  // did not take, yet further than the region's radius from the one it did (traced on Andorra: a
+  // whole outage driven down the wrong branch at 28 m/s).
+  for (EdgeId e : graph_.out_edges(graph_.tail(start_.edge))) {
+    if (e == start_.edge) continue;
+    const double off = std::min(start_.offset_m, graph_.length_m(e));
+    add(e, off, maps::distance_m(graph_.point_along(e, off), start_.point));
+  }
   if (snapper_ != nullptr) {
     const double radius = std::max(config_.start_radius_m, 2.0 * sigma);
     for (const maps::SnapResult& c : snapper_->candidates_local(start_.point, radius, 8)) {

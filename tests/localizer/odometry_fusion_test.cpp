@@ -252,6 +252,36 @@ TEST(OdometryMapMatcher, ABendTakesOutTheAlongRoadDrift) {
   EXPECT_LT(maps::distance_m(p.point, truth), 5.5);  // 8 m short without the siblings
 }
 
+// A fork whose one-way branches part by 25° at (0, 100); 100 m on, the left one (A) bends away
+// to the north-west while the right one (B) runs on. The vehicle took B and is 28 m down it when
+// GPS goes; the online match put it on A, and the fixes' mean lies 15.6 m from A but 27.3 m from
+// B, outside the confidence region's 25 m. The other exits of the node behind the match start
+// too, as far past it: where A bends and the odometry runs on straight, B wins.
+TEST(OdometryMapMatcher, TheOtherBranchOfAForkJustPassedStartsToo) {
+  Sketch s;
+  const double pi = 3.14159265358979, half = 12.5 * pi / 180.0, away = -55.0 * pi / 180.0;
+  const maps::Point2 bend{-100 * std::sin(half), 100 + 100 * std::cos(half)};
+  s.nodes = {{0, 0}, {0, 100}, bend, {bend.x_m + 300 * std::sin(away), bend.y_m + 300 * std::cos(away)},
+             {400 * std::sin(half), 100 + 400 * std::cos(half)}};
+  s.roads = {{{0, 1}, true, 1}, {{1, 2, 3}, true, 2}, {{1, 4}, true, 3}};
+  const auto g = s.build();
+  const maps::EdgeSnapper snapper(g);
+  OdometryMapMatcher m(g, {}, &snapper);
+  const EdgeId a = edge_between(g, s.nodes[1], bend), b = edge_between(g, s.nodes[1], s.nodes[4]);
+  OdometryStart from;
+  from.edge = a;
+  from.offset_m = 27.0;
+  from.point = {-22.0, 127.0};
+  from.heading_deg = 12.5;
+  from.heading_sigma_deg = 20.0;
+  from.sigma_m = 10.0;
+  m.start(from);
+  MatchedPoint p;
+  for (int t = 1; t <= 20; ++t) p = m.advance({static_cast<double>(t), 10.0, 0.0});
+  EXPECT_EQ(p.edge, b);
+  EXPECT_NEAR(p.offset_m, 228.0, 10.0);
+}
+
 // An octagon of two-way road (sides 61 m), driven clockwise: five right turns of 45°, each
 // rounded on an 8 m arc 1.75 m right of the centre line, so the vehicle drives 1.72 m less than
 // the centre lines at each (corner_cut.hpp). The odometry measures the arcs exactly; the
