@@ -83,13 +83,7 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
   std::mt19937_64 rng(config.seed * 7919 + 3);
   std::normal_distribution<double> gauss(0.0, 1.0);
   localizer::SimulatedOdometry odometry({}, config.seed * 7919 + 5);
-  struct Pose {
-    maps::Point2 position;
-    double angle_deg = 0;
-    double speed_mps = 0;
-    double time_s = 0;
-  };
-  std::optional<Pose> last_truth;
+  std::optional<std::pair<maps::Point2, double>> last_truth;  // position, angle
   double last_fix_s = -1e9;
   std::optional<std::uint64_t> mission;
   std::vector<std::string> route;
@@ -187,16 +181,10 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
           const maps::Point2 truth{pos->x, pos->y};
           const double angle = sumo_angle;
           const double speed = as_double(ev, libsumo::VAR_SPEED);
-          if (last_truth) {
-            // The distance driven along the lane (the mean of the step's two speeds, as SUMO's
-            // ballistic update moves it); the straight line cuts bends.
-            std::optional<double> path_m;
-            if (last_truth->speed_mps > 0.0 && speed > 0.0 && t > last_truth->time_s) {
-              path_m = std::max(maps::distance_m(last_truth->position, truth), 0.5 * (last_truth->speed_mps + speed) * (t - last_truth->time_s));
-            }
-            onboard.on_odometry(odometry.step(t, last_truth->position, last_truth->angle_deg, truth, angle, path_m));
-          }
-          last_truth = Pose{truth, angle, speed, t};
+          // The straight line between two steps: the loop runs SUMO's default (Euler) update, where
+          // the step's speeds are not the distance it moved (a braking step moves by the new speed).
+          if (last_truth) onboard.on_odometry(odometry.step(t, last_truth->first, last_truth->second, truth, angle));
+          last_truth = {truth, angle};
           const double since = t - ev_depart;
           const bool out = std::any_of(config.gps_outages.begin(), config.gps_outages.end(),
                                        [&](const auto& w) { return since >= w.first && since < w.second; });

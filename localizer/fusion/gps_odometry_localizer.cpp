@@ -267,7 +267,10 @@ LocalizedPoint GpsOdometryLocalizer::on_odometry(const OdometryStep& reported) {
   if (step.time_s - last_good_gps_s_ <= takeover_s_) {
     // Between two fixes the last one is carried on by the odometry (the hypotheses it started
     // from that fix), not held: a 1 Hz receiver's fix is up to a second old, 30 m at 30 m/s. It
-    // is still GPS's position, dead-reckoned for less than the takeover time.
+    // is still GPS's position, dead-reckoned for less than the takeover time. The odometry's best
+    // hypothesis is taken even off the fix's road and its exits: holding the fix's own match to
+    // its road instead (against a parallel street leading for a moment) stuck it at the road's
+    // end on short streets and lost 0.3 points of a GPS outage on Monaco.
     const MatchedPoint m = odometry_.advance(step);
     if (!m.matched || !(step.time_s > last_good_gps_s_) || last_.source != PositionSource::gps) return last_;
     return output(PositionSource::gps, m, std::max(last_.sigma_m, odometry_.sigma_m()));

@@ -12,8 +12,11 @@ void OdometryScale::on_fix(double time_s, std::optional<double> speed_mps, doubl
     return;
   }
   const Last now{time_s, *speed_mps, odometry_m};
-  if (!last_ || !(time_s > last_->time_s)) {
-    if (!last_) last_ = now;  // a repeated or older time neither starts nor ends an interval
+  // A repeated time is no interval; an older one (a clock that went back, a replay started over)
+  // starts the next interval afresh rather than stopping the calibration until time catches up.
+  if (last_ && time_s == last_->time_s) return;
+  if (!last_ || time_s < last_->time_s || odometry_m < last_->odometry_m) {
+    last_ = now;
     return;
   }
   const Last before = *last_;

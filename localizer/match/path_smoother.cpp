@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <tuple>
 #include <unordered_map>
 
 namespace corridor::localizer {
@@ -33,8 +34,8 @@ double driven_m(std::span<const GpsFix> fixes, std::size_t a, std::size_t b, dou
 
 // The distance a vehicle drives along a matched path, against the path's own distance s along the
 // road's centre lines. A vehicle rounds each corner on an arc instead of running to the vertex and
-// turning there, and keeps to its side of a two-way road, so a right turn is shorter for it and a
-// left turn longer by its offset times the angle. The receiver's speeds measure the driven
+// turning there, and keeps to its side of a two-way road, so it drives less than the centre lines
+// through a turn, more so through a turn to its side (corner_cut.hpp). The receiver's speeds measure the driven
 // distance u; the fixes' projections measure s. u(s) is piecewise linear (each vertex's difference
 // spread over the arc), increasing, and inverted by bisection over its breakpoints.
 class DrivenCoordinate {
@@ -268,18 +269,27 @@ std::vector<MatchedPoint> smooth_along_path(const maps::RoadGraph& g, planner::B
       // edge one ends on and the edge the other starts on: a fix set aside between them goes to the
       // nearer of the two where it lies within 3σ of it (a turn through a junction our graph draws
       // elsewhere, where SUMO's vehicle cut across); further off, it keeps no estimate.
+      // On the first edge it goes no further back than the first part's end, on the second no
+      // further on than the second part's start: a multipath fix thrown along the road is not
+      // followed there either.
       const EdgeId before_gap = head.back().edge, after_gap = tail.front().edge;
       for (std::size_t k = last + 1; k < i; ++k) {
         MatchedPoint m = points[k];
         const maps::Point2 raw = g.projection().to_local(fixes[k].position);
-        const auto a = g.nearest_point(before_gap, raw), b = g.nearest_point(after_gap, raw);
-        const bool to_before = a.distance_m <= b.distance_m;
-        const maps::RoadGraph::EdgePoint& at = to_before ? a : b;
-        if (at.distance_m <= 3.0 * sigma_of(fixes[k])) {
+        auto on = [&](EdgeId e, double from_m, double to_m) {
+          const double offset = std::clamp(g.nearest_point(e, raw).offset_m, from_m, std::max(from_m, to_m));
+          const maps::Point2 p = g.point_along(e, offset);
+          return std::tuple{maps::distance_m(p, raw), offset, p};
+        };
+        const auto a = on(before_gap, head.back().offset_m, g.length_m(before_gap));
+        const auto b = on(after_gap, 0.0, tail.front().offset_m);
+        const bool to_before = std::get<0>(a) <= std::get<0>(b);
+        const auto& [distance, offset, point] = to_before ? a : b;
+        if (distance <= 3.0 * sigma_of(fixes[k])) {
           m.matched = true;
           m.edge = to_before ? before_gap : after_gap;
-          m.offset_m = at.offset_m;
-          m.point = at.point;
+          m.offset_m = offset;
+          m.point = point;
         }
         head.push_back(m);
       }

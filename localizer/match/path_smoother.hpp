@@ -11,7 +11,7 @@
 // fixes moved, or than the speeds say was driven (a detour round a road the graph lacks).
 // The filter runs on the distance the vehicle drove, which the speeds measure: a vehicle rounds
 // corners and keeps to its side of the road, so it drives less than the centre lines through a
-// right turn (where traffic keeps right) and more through a left one.
+// turn, most through a right turn where traffic keeps right (corner_cut.hpp).
 #pragma once
 
 #include <span>

@@ -40,10 +40,14 @@ bool beyond_ends(const maps::RoadGraph& g, EdgeId e, maps::Point2 p, double marg
   const maps::RoadGraph::EdgePoint nearest = g.nearest_point(e, p);
   const bool at_tail = nearest.offset_m <= 1e-6, at_head = nearest.offset_m >= g.length_m(e) - 1e-6;
   if (!at_tail && !at_head) return false;
+  // The end piece's direction, from the first point before the end that is not the end itself.
   const maps::Point2 end = at_head ? pts[pts.size() - 1] : pts[0];
-  const maps::Point2 inner = at_head ? pts[pts.size() - 2] : pts[1];
-  const double dx = end.x_m - inner.x_m, dy = end.y_m - inner.y_m, len = std::hypot(dx, dy);
-  return len > 0.0 && ((p.x_m - end.x_m) * dx + (p.y_m - end.y_m) * dy) / len > margin_m;
+  for (std::size_t k = 1; k < pts.size(); ++k) {
+    const maps::Point2 inner = at_head ? pts[pts.size() - 1 - k] : pts[k];
+    const double dx = end.x_m - inner.x_m, dy = end.y_m - inner.y_m, len = std::hypot(dx, dy);
+    if (len > 1e-6) return ((p.x_m - end.x_m) * dx + (p.y_m - end.y_m) * dy) / len > margin_m;
+  }
+  return false;
 }
 
 // The farthest apart that SUMO's junction joining puts OSM nodes of one junction
@@ -57,7 +61,9 @@ constexpr double kJunctionSpanM = 60.0;
 // straight line between 1 Hz samples is a chord, 1.5 % shorter than the lane on Monaco's curves,
 // where a 10 Hz odometry follows the lane. A lane change is a sideways jump in SUMO, which only
 // the straight line sees, so the longer of the two counts; a step that ends at a stop does not use
-// the speeds (the vehicle stopped somewhere inside it).
+// the speeds (the vehicle stopped somewhere inside it). This assumes the ballistic update, which
+// scripts/sumo_fcd_drives.py uses by default: under the Euler one (--step-method euler) a braking
+// step moves by its new speed, and the mean of the two overstates it.
 double driven_m(const TruthSample& a, const TruthSample& b, maps::Point2 pa, maps::Point2 pb) {
   const double chord = maps::distance_m(pa, pb);
   if (!(a.speed_mps > 0.0) || !(b.speed_mps > 0.0) || !(b.time_s > a.time_s)) return chord;

@@ -526,8 +526,8 @@ TEST_F(LocalizerOnCrossroads, AFastReceiversLatencyDoesNotHandOverBetweenItsFixe
 }
 
 // A 1 Hz receiver, odometry at 10 Hz. When a fix does not come, the odometry takes over once one
-// and a half of the fixes' intervals have passed (not after the 2.5 s timeout): the position
-// moves on instead of standing at the last fix while the vehicle drives away from it.
+// and a half of the fixes' intervals have passed (not after the 2.5 s timeout): the source says
+// so, and the position is where the vehicle drove to.
 TEST_F(LocalizerOnCrossroads, AnOverdueFixHandsOverToTheOdometrySoonerThanTheTimeout) {
   const double x = drive_east(10);
   ASSERT_EQ(p.source, PositionSource::gps);  // the last fix, at t = 10 s
@@ -589,8 +589,6 @@ TEST(LocalizationStudy, TrueEdgesFollowTheLaneWayAndSpanAJunction) {
   EXPECT_EQ(truth[3].edge, edge_between(g, {-300, 4}, {-10, 4}));  // no lane: the nearest road
 }
 
-// SUMO drives some ways our importer leaves out (a street closed to motor vehicles): a sample on
-// such a way's lane has no true edge, though one of our roads runs 4 m from it.
 // netconvert joins way 1 and way 2, which meet end to end with no junction, into one edge whose lane
 // names way 1 only. A vehicle on that lane 3 m past the node has driven onto way 2, though way 1's
 // end lies within 4 m; one 0.5 m short of the node is still on way 1.
@@ -640,6 +638,8 @@ TEST(LocalizationStudy, AHairpinsLaneIsOnItsWayAllTheWayRound) {
   EXPECT_EQ(g.osm_way(truth[0].edge).v, 1);
 }
 
+// SUMO drives some ways our importer leaves out (a street closed to motor vehicles): a sample on
+// such a way's lane has no true edge, though one of our roads runs 4 m from it.
 TEST(LocalizationStudy, ALaneOnAWayTheGraphLacksHasNoTrueEdge) {
   Sketch s;
   s.nodes = {{-300, 0}, {300, 0}};

@@ -12,24 +12,27 @@ namespace corridor::localizer {
 namespace {
 
 // 1 Hz fixes of a vehicle whose speed wanders between 6 and 14 m/s, with the receiver's speed
-// noise (0.3 m/s), and an odometry that reports `scale` times the distance driven.
-double calibrate(OdometryScale& s, double scale, int fixes, std::uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> noise(0.0, 0.3);
-  double odometry_m = 0.0, v = 10.0;
-  for (int k = 0; k < fixes; ++k) {
-    const double v_next = 10.0 + 4.0 * std::sin(0.05 * (k + 1));
-    if (k > 0) odometry_m += scale * 0.5 * (v + v_next);  // the distance driven, as the odometry reports it
-    v = v_next;
-    s.on_fix(static_cast<double>(k), v + noise(rng), odometry_m);
+// noise (0.3 m/s), and an odometry that reports `scale` times the distance driven. Each call
+// drives on from where the last one stopped.
+struct Drive {
+  double time_s = 0, odometry_m = 0, v = 10.0;
+  std::mt19937_64 rng{7};
+  std::normal_distribution<double> noise{0.0, 0.3};
+  void calibrate(OdometryScale& s, double scale, int fixes) {
+    for (int k = 0; k < fixes; ++k) {
+      const double v_next = 10.0 + 4.0 * std::sin(0.05 * (time_s + 1.0));
+      if (time_s > 0.0) odometry_m += scale * 0.5 * (v + v_next);  // the distance driven, as the odometry reports it
+      v = v_next;
+      s.on_fix(time_s, v + noise(rng), odometry_m);
+      time_s += 1.0;
+    }
   }
-  return odometry_m;
-}
+};
 
 TEST(OdometryScale, LearnsTheScaleFromTheReceiversSpeed) {
   for (const double scale : {0.97, 1.0, 1.02}) {
     OdometryScale s;
-    calibrate(s, scale, 400, 7);
+    Drive().calibrate(s, scale, 400);
     EXPECT_NEAR(s.factor() * scale, 1.0, 0.002) << "odometry scale " << scale;
     EXPECT_GT(s.calibrated_m(), 300.0);
   }
@@ -37,9 +40,24 @@ TEST(OdometryScale, LearnsTheScaleFromTheReceiversSpeed) {
 
 TEST(OdometryScale, StaysOneUntilEnoughHasBeenDriven) {
   OdometryScale s;
-  calibrate(s, 1.03, 20, 1);  // 190 m
+  Drive d;
+  d.calibrate(s, 1.03, 25);  // about 260 m of odometry
+  EXPECT_LT(s.calibrated_m(), 300.0);
   EXPECT_EQ(s.factor(), 1.0);
-  calibrate(s, 1.03, 60, 2);
+  d.calibrate(s, 1.03, 60);
+  EXPECT_GT(s.calibrated_m(), 300.0);
+  EXPECT_NEAR(s.factor(), 1.0 / 1.03, 0.01);
+}
+
+// A clock that goes back (a replay started over) starts the next interval afresh: the calibration
+// goes on rather than waiting for time to pass the old maximum.
+TEST(OdometryScale, AClockThatGoesBackStartsAfresh) {
+  OdometryScale s;
+  Drive d;
+  d.calibrate(s, 1.03, 20);
+  d.time_s = 0.0;
+  d.calibrate(s, 1.03, 60);
+  EXPECT_GT(s.calibrated_m(), 700.0);
   EXPECT_NEAR(s.factor(), 1.0 / 1.03, 0.01);
 }
 
@@ -72,7 +90,7 @@ TEST(OdometryScale, StopsGapsAndImplausibleIntervalsDoNotCount) {
 
 TEST(OdometryScale, TheCorrectionIsBounded) {
   OdometryScale s;
-  calibrate(s, 1.15, 400, 3);
+  Drive().calibrate(s, 1.15, 400);
   EXPECT_DOUBLE_EQ(s.factor(), 0.95);
 }
 

@@ -255,6 +255,21 @@ TEST(PathSmoother, AFixInTheGapOfASplitChainGoesToTheNearerEdgeAroundIt) {
   EXPECT_FALSE(out[22].matched);
 }
 
+// The corner model's figures: 2·8 − 8·π/2 ± 1.75·π/2 through a right angle; less where the pieces
+// either side are too short for the arc; a hairpin sharper than 149° what 149° saves; nothing
+// straight on, nor for a NaN.
+TEST(CornerCut, SavesWhatTheArcAndTheLaneSaveAndNoMoreThroughAHairpin) {
+  const double pi = 3.14159265358979;
+  EXPECT_NEAR(corner_cut(pi / 2, 50, 50, 8.0, 1.75).saving_m, 16.0 - 4.0 * pi + 0.875 * pi, 1e-9);
+  EXPECT_NEAR(corner_cut(-pi / 2, 50, 50, 8.0, 1.75).saving_m, 16.0 - 4.0 * pi - 0.875 * pi, 1e-9);
+  EXPECT_NEAR(corner_cut(pi / 2, 4, 50, 8.0, 1.75).saving_m, 4.0 - pi + 0.875 * pi, 1e-9);  // a 2 m arc
+  const double t = std::tan(0.5 * kMaxCornerRad);  // the arc's radius is cut to fit 50 m pieces: 25 / t
+  EXPECT_NEAR(corner_cut(pi, 50, 50, 8.0, 1.75).saving_m, 50.0 - 25.0 / t * kMaxCornerRad + 1.75 * kMaxCornerRad, 1e-9);
+  EXPECT_NEAR(corner_cut(-160.0 * pi / 180.0, 50, 50, 8.0, 1.75).saving_m, 50.0 - 25.0 / t * kMaxCornerRad - 1.75 * kMaxCornerRad, 1e-9);
+  EXPECT_EQ(corner_cut(std::nan(""), 50, 50, 8.0, 1.75).saving_m, 0.0);
+  EXPECT_EQ(corner_cut(0.0, 50, 50, 8.0, 1.75).saving_m, 0.0);
+}
+
 // A two-way road east to B (300, 0), then a 90° turn onto one that runs on south (right where
 // traffic keeps right) or north (left). A vehicle at 10 m/s rounds the corner on an 8 m arc 1.75 m
 // to its side of the centre lines: through a right turn it drives 2·8 − 8·π/2 + 1.75·π/2 = 6.18 m
