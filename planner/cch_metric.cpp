@@ -15,8 +15,8 @@ CchMetric::CchMetric(const CchTopology& topology, const TravelCost& cost, CchMet
       options_(options),
       up_(topology.arc_count(), kInfCost),
       down_(topology.arc_count(), kInfCost),
-      via_up_(topology.arc_count(), kNoCchArc),
-      via_down_(topology.arc_count(), kNoCchArc),
+      via_up_(topology.arc_count()),
+      via_down_(topology.arc_count()),
       slot_(topology.arc_count(), 0),
       queue_(topology.arc_count()) {
   if (options_.lazy_rises) {
@@ -95,11 +95,11 @@ void CchMetric::customize_all(std::vector<std::uint8_t>& open) {
         const double down = add_cost(down_[xb], x_to_a);
         if (up < up_[ab]) {
           up_[ab] = up;
-          via_up_[ab] = x;
+          via_up_[ab] = Witness{xa, xb};
         }
         if (down < down_[ab]) {
           down_[ab] = down;
-          via_down_[ab] = x;
+          via_down_[ab] = Witness{xa, xb};
         }
       }
     }
@@ -165,13 +165,15 @@ void CchMetric::build_open_lists() {
 
 namespace {
 
-std::uint32_t tail_of(const CchDownArc& d) { return d.tail; }
+// A lambda, not a function: gallop_to takes the key by value, and a function pointer there is not
+// inlined.
+constexpr auto tail_of = [](const CchDownArc& d) { return d.tail; };
 
 }  // namespace
 
-CchMetric::Derived CchMetric::derive(std::uint32_t arc, bool upward) const {
+template <class F>
+void CchMetric::for_each_lower_triangle(std::uint32_t arc, bool upward, F&& f) const {
   const CchTopology& t = *topology_;
-  Derived d{input_cost(arc, upward), kNoCchArc};
   const std::uint32_t x = t.tail(arc), y = t.head(arc);
   // Lower triangles {z, x, y}, z below x, open the way asked: x→z→y upward, y→z→x downward.
   // Both lists ascend by z.
@@ -185,15 +187,18 @@ CchMetric::Derived CchMetric::derive(std::uint32_t arc, bool upward) const {
     } else if (j->tail < i->tail) {
       j = gallop_to(j, zy.end(), i->tail, tail_of);
     } else {
-      const double w = upward ? add_cost(down_[i->arc], up_[j->arc]) : add_cost(down_[j->arc], up_[i->arc]);
-      if (w < d.weight) {
-        d.weight = w;
-        d.via = i->tail;
-      }
+      f(upward ? add_cost(down_[i->arc], up_[j->arc]) : add_cost(down_[j->arc], up_[i->arc]), Witness{i->arc, j->arc});
       ++i;
       ++j;
     }
   }
+}
+
+CchMetric::Derived CchMetric::derive(std::uint32_t arc, bool upward) const {
+  Derived d{input_cost(arc, upward), Witness{}};
+  for_each_lower_triangle(arc, upward, [&](double w, Witness via) {
+    if (w < d.weight) d = Derived{w, via};
+  });
   return d;
 }
 
@@ -208,7 +213,7 @@ void CchMetric::queue(std::uint32_t arc, std::uint8_t derive) {
   queue_.push(arc);
 }
 
-void CchMetric::offer(std::uint32_t arc, bool upward, double old_s, double new_s, std::uint32_t via) {
+void CchMetric::offer(std::uint32_t arc, bool upward, double old_s, double new_s, Witness via) {
   const double current = upward ? up_[arc] : down_[arc];
   if (new_s < current) {
     queue(arc, 0);
@@ -222,6 +227,7 @@ void CchMetric::offer(std::uint32_t arc, bool upward, double old_s, double new_s
     // The arc's own witness got cheaper and the weight did not move: the fall vanished in
     // rounding. The path under the weight changed all the same (a side took a new witness), so
     // the arc and every arc above it must be looked at again, as after a rise.
+    (upward ? exact_up_[arc] : exact_down_[arc]) = 0;
     mark_changed(arc);
   }
 }
@@ -282,18 +288,22 @@ CustomizationStats CchMetric::propagate(std::vector<std::uint32_t>& changed) {
       if ((p.derive & (upward ? kUp : kDown)) == 0) continue;
       ++stats.recomputed;
       double& w = upward ? up_[arc] : down_[arc];
-      std::uint32_t& via = upward ? via_up_[arc] : via_down_[arc];
+      Witness& via = upward ? via_up_[arc] : via_down_[arc];
       if (options_.lazy_rises) {
         // Only a cheaper input can move a lower bound down; a dearer one waits for settle(), and
         // from now on every weight whose path may use it is stale (mark_changed).
         const std::uint32_t input = upward ? t.input(arc).up : t.input(arc).down;
         const double in = input == kNoCchArc ? kInfCost : input_s(input);
         double& kept = upward ? input_up_[arc] : input_down_[arc];
-        if (in > kept) mark_changed(arc);
+        if (in > kept) {
+          mark_changed(arc);
+          // A weight that is this input's cost is a real path's cost no longer.
+          if (via.input()) (upward ? exact_up_[arc] : exact_down_[arc]) = 0;
+        }
         kept = in;
         if (in < w) {
           w = in;
-          via = kNoCchArc;
+          via = Witness{};
         }
       } else {
         const Derived d = derive(arc, upward);
@@ -347,7 +357,9 @@ CustomizationStats CchMetric::propagate(std::vector<std::uint32_t>& changed) {
         const double side = from_y ? (queued != nullptr ? queued->old_up : up_[xz])
                                    : (queued != nullptr ? queued->old_down : down_[xz]);
         if (side >= kInfCost) continue;
-        offer(between(z, k, m), from_y == (z > y), add_cost(old_s, side), add_cost(new_s, side), x);
+        // The arc {y, z}'s witness is x: its sides are {x, y} (this arc) and {x, z}.
+        const Witness via = z > y ? Witness{arc, xz} : Witness{xz, arc};
+        offer(between(z, k, m), from_y == (z > y), add_cost(old_s, side), add_cost(new_s, side), via);
       }
     };
     if (down_moved) offer_triangles(true, p.old_down, down_[arc]);
@@ -359,55 +371,79 @@ CustomizationStats CchMetric::propagate(std::vector<std::uint32_t>& changed) {
 
 void CchMetric::unpack(std::uint32_t arc, bool upward, std::vector<std::uint32_t>& out) const {
   const CchTopology& t = *topology_;
-  const std::uint32_t x = t.tail(arc), y = t.head(arc);
-  const std::uint32_t z = upward ? via_up_[arc] : via_down_[arc];
-  if (z == kNoCchArc) {
-    out.push_back(t.vertex_at(upward ? y : x));
+  const Witness w = upward ? via_up_[arc] : via_down_[arc];
+  if (w.input()) {
+    out.push_back(t.vertex_at(upward ? t.head(arc) : t.tail(arc)));
     return;
   }
   // A shortcut: x→z→y upward, y→z→x downward, z below both.
-  const auto [zx, zy] = t.find_arcs_up(z, x, y);
   if (upward) {
-    unpack(zx, false, out);
-    unpack(zy, true, out);
+    unpack(w.to_tail, false, out);
+    unpack(w.to_head, true, out);
   } else {
-    unpack(zy, false, out);
-    unpack(zx, true, out);
+    unpack(w.to_head, false, out);
+    unpack(w.to_tail, true, out);
   }
 }
 
 double CchMetric::settle(std::uint32_t arc, bool upward, std::vector<std::uint32_t>& raised) {
-  if (!options_.lazy_rises) return upward ? up_[arc] : down_[arc];
-  const CchTopology& t = *topology_;
-  // Every weight is at most its triangles' sums and its input (a fall is carried up at once, a
-  // rise only raises them), and so at most its true value. Each round either ends or moves the
-  // witness to another triangle of lower-bound sum; sums only rise as witnesses settle, so the
-  // rounds end.
-  std::uint32_t& exact = upward ? exact_up_[arc] : exact_down_[arc];
-  if (known_exact(arc, upward)) return upward ? up_[arc] : down_[arc];
-  for (;;) {
-    const std::uint32_t z = upward ? via_up_[arc] : via_down_[arc];
-    double witnessed = kInfCost;
-    if (z == kNoCchArc) {
-      witnessed = input_cost(arc, upward);
-    } else {
-      // x→z→y upward, y→z→x downward, z below both (as unpack follows them).
-      const auto [zx, zy] = t.find_arcs_up(z, t.tail(arc), t.head(arc));
-      witnessed = upward ? add_cost(settle(zx, false, raised), settle(zy, true, raised))
-                         : add_cost(settle(zy, false, raised), settle(zx, true, raised));
-    }
-    double& w = upward ? up_[arc] : down_[arc];
-    if (witnessed == w) break;
-    const Derived d = derive(arc, upward);
-    assert(d.weight >= w);
-    // A tie through another witness moves no weight: nothing for the planner to repair.
-    if (d.weight != w) raised.push_back(arc);
-    w = d.weight;
-    (upward ? via_up_[arc] : via_down_[arc]) = d.via;
-    if (d.via == z) break;  // the same witness, now settled: the weight is its path's cost
+  double& w = upward ? up_[arc] : down_[arc];
+  if (!options_.lazy_rises) return w;
+  if (known_exact(arc, upward)) return w;
+  // The weight's own witness first: settled, it is the cost of a real path, and where that equals
+  // the weight (the common case) the lower bound is attained, so exact.
+  const Witness& via = upward ? via_up_[arc] : via_down_[arc];
+  const auto settled_sum = [&](Witness z) {
+    // x→z→y upward, y→z→x downward, z below both (as unpack follows them).
+    return upward ? add_cost(settle(z.to_tail, false, raised), settle(z.to_head, true, raised))
+                  : add_cost(settle(z.to_head, false, raised), settle(z.to_tail, true, raised));
+  };
+  Derived best{input_cost(arc, upward), Witness{}};
+  if (!via.input()) {
+    const Witness z = via;
+    const double s = settled_sum(z);
+    if (s < best.weight) best = Derived{s, z};
   }
-  exact = batch_;
-  return upward ? up_[arc] : down_[arc];
+  if (best.weight != w) {
+    // The witness rose. Every weight is at most its triangles' sums and its input (a fall is
+    // carried up at once, a rise only raises them), so each triangle's sum today is a lower bound
+    // of its real cost. The triangles are read once, those below the best real path so far taken
+    // in order of their bounds, each settled; once the next bound is no lower than the best
+    // settled sum, no triangle can beat it. Settling raises weights only, so the bounds read
+    // stay bounds while the sides below them are settled.
+    const std::size_t base = candidates_.size();
+    for_each_lower_triangle(arc, upward, [&](double s, Witness z) {
+      if (s < best.weight) candidates_.push_back(Derived{s, z});
+    });
+    std::sort(candidates_.begin() + static_cast<std::ptrdiff_t>(base), candidates_.end(),
+              [](const Derived& a, const Derived& b) { return a.weight < b.weight; });
+    const std::size_t end = candidates_.size();
+    for (std::size_t i = base; i < end; ++i) {
+      const Derived c = candidates_[i];  // a copy: settling below pushes onto candidates_ too
+      if (c.weight >= best.weight) break;
+      // Its sides may have been raised since it was read, while settling others.
+      const double now = upward ? add_cost(down_[c.via.to_tail], up_[c.via.to_head])
+                                : add_cost(down_[c.via.to_head], up_[c.via.to_tail]);
+      if (now >= best.weight) continue;
+      const double s = settled_sum(c.via);
+      if (s < best.weight) best = Derived{s, c.via};
+    }
+    candidates_.resize(base);
+    assert(best.weight >= w);
+    // A tie through another witness moves no weight: nothing for the planner to repair.
+    if (best.weight != w) raised.push_back(arc);
+    w = best.weight;
+    (upward ? via_up_[arc] : via_down_[arc]) = best.via;
+  }
+  (upward ? exact_up_[arc] : exact_down_[arc]) = batch_;
+  return w;
+}
+
+bool CchMetric::is_triangle(std::uint32_t arc, Witness w) const {
+  const CchTopology& t = *topology_;
+  const std::uint32_t n = t.arc_count();
+  return w.to_tail < n && w.to_head < n && t.tail(w.to_tail) == t.tail(w.to_head) &&
+         t.head(w.to_tail) == t.tail(arc) && t.head(w.to_head) == t.head(arc);
 }
 
 std::string CchMetric::invariant_violation() const {
@@ -433,11 +469,11 @@ std::string CchMetric::invariant_violation() const {
       for (const bool upward : {true, false}) {
         if (!known_exact(arc, upward)) continue;
         const double w = upward ? up_[arc] : down_[arc];
-        const std::uint32_t z = upward ? via_up_[arc] : via_down_[arc];
+        const Witness z = upward ? via_up_[arc] : via_down_[arc];
         double witnessed = input_cost(arc, upward);
-        if (z != kNoCchArc) {
-          const auto [zx, zy] = t.find_arcs_up(z, t.tail(arc), t.head(arc));
-          if (zx == kNoCchArc || zy == kNoCchArc) return "arc " + std::to_string(arc) + "'s witness is not a triangle";
+        if (!z.input()) {
+          if (!is_triangle(arc, z)) return "arc " + std::to_string(arc) + "'s witness is not a triangle";
+          const std::uint32_t zx = z.to_tail, zy = z.to_head;
           if (!known_exact(zx, !upward) || !known_exact(zy, upward)) {
             return "arc " + std::to_string(arc) + (upward ? " up" : " down") +
                    " is taken as exact over a side that is not";
@@ -460,16 +496,13 @@ std::string CchMetric::invariant_violation() const {
     for (const bool upward : {true, false}) {
       const double w = upward ? up_[arc] : down_[arc];
       if (w >= kInfCost) continue;
-      const std::uint32_t z = upward ? via_up_[arc] : via_down_[arc];
+      const Witness z = upward ? via_up_[arc] : via_down_[arc];
       const std::uint32_t input = upward ? in.up : in.down;
       double witnessed = kInfCost;
-      if (z == kNoCchArc) {
+      if (z.input()) {
         if (input != kNoCchArc) witnessed = input_s(input);
-      } else {
-        const std::uint32_t zx = t.find_arc(z, t.tail(arc)), zy = t.find_arc(z, t.head(arc));
-        if (zx != kNoCchArc && zy != kNoCchArc) {
-          witnessed = upward ? add_cost(down_[zx], up_[zy]) : add_cost(down_[zy], up_[zx]);
-        }
+      } else if (is_triangle(arc, z)) {
+        witnessed = upward ? add_cost(down_[z.to_tail], up_[z.to_head]) : add_cost(down_[z.to_head], up_[z.to_tail]);
       }
       if (witnessed != w) {
         return "arc " + std::to_string(arc) + (upward ? " up" : " down") + " weighs " + std::to_string(w) +
@@ -482,7 +515,8 @@ std::string CchMetric::invariant_violation() const {
 
 std::size_t CchMetric::memory_bytes() const {
   return (up_.size() + down_.size() + input_up_.size() + input_down_.size()) * sizeof(double) +
-         (via_up_.size() + via_down_.size() + slot_.size() + changed_below_.size() + parent_.size() + exact_up_.size() +
+         (via_up_.size() + via_down_.size()) * sizeof(Witness) +
+         (slot_.size() + changed_below_.size() + parent_.size() + exact_up_.size() +
           exact_down_.size()) *
              sizeof(std::uint32_t) +
          queue_.memory_bytes() +

@@ -144,17 +144,6 @@ std::uint32_t CchTopology::find_arc(std::uint32_t a, std::uint32_t b) const {
   return first_up_[a] + static_cast<std::uint32_t>(it - ups.begin());
 }
 
-std::pair<std::uint32_t, std::uint32_t> CchTopology::find_arcs_up(std::uint32_t z, std::uint32_t x,
-                                                                  std::uint32_t y) const {
-  const auto ups = up(z);
-  const auto ix = std::lower_bound(ups.begin(), ups.end(), x);
-  const auto iy = std::lower_bound(ix, ups.end(), y);
-  const auto arc = [&](auto it, std::uint32_t r) {
-    return it == ups.end() || *it != r ? kNoCchArc : first_up_[z] + static_cast<std::uint32_t>(it - ups.begin());
-  };
-  return {arc(ix, x), arc(iy, y)};
-}
-
 void CchTopology::ancestors(std::span<const std::uint32_t> from, std::vector<std::uint32_t>& out) const {
   out.clear();
   for (std::uint32_t r : from) {

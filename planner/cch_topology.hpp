@@ -57,10 +57,6 @@ class CchTopology {
   [[nodiscard]] std::uint32_t head(std::uint32_t arc) const { return up_head_[arc]; }
   // The arc joining ranks a and b (either order), or kNoCchArc.
   [[nodiscard]] std::uint32_t find_arc(std::uint32_t a, std::uint32_t b) const;
-  // The arcs joining z to x and to y, for z below x below y (a lower triangle's sides), each
-  // kNoCchArc where there is none: one search of z's higher neighbours for both.
-  [[nodiscard]] std::pair<std::uint32_t, std::uint32_t> find_arcs_up(std::uint32_t z, std::uint32_t x,
-                                                                     std::uint32_t y) const;
   // The elimination tree: the lowest higher neighbour, or kNoCchArc at a root. Every higher
   // neighbour of r is an ancestor of r in this tree (the supergraph is chordal).
   [[nodiscard]] std::uint32_t parent(std::uint32_t r) const {

@@ -58,7 +58,7 @@ struct DispatchConfig {
   double max_hierarchy_density = 16.0;
   // Cost models (a profile at a top speed) the hierarchy keeps a metric for at once; a mission of
   // yet another one plans on the turn graph. Each costs a customization per congestion batch and
-  // 46 bytes per arc (57 MB on Porto); top speeds are the client's to choose.
+  // 54 bytes per arc (67 MB on Porto); top speeds are the client's to choose.
   int max_hierarchy_models = 4;
   preemption::PreemptionConfig preemption;
 };
