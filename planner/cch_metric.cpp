@@ -187,7 +187,8 @@ void CchMetric::for_each_lower_triangle(std::uint32_t arc, bool upward, F&& f) c
     } else if (j->tail < i->tail) {
       j = gallop_to(j, zy.end(), i->tail, tail_of);
     } else {
-      f(upward ? add_cost(down_[i->arc], up_[j->arc]) : add_cost(down_[j->arc], up_[i->arc]), Witness{i->arc, j->arc});
+      const Witness z{i->arc, j->arc};
+      f(side_sum(z, upward), z);
       ++i;
       ++j;
     }
@@ -392,17 +393,16 @@ double CchMetric::settle(std::uint32_t arc, bool upward, std::vector<std::uint32
   if (known_exact(arc, upward)) return w;
   // The weight's own witness first: settled, it is the cost of a real path, and where that equals
   // the weight (the common case) the lower bound is attained, so exact.
-  const Witness& via = upward ? via_up_[arc] : via_down_[arc];
+  const Witness own = upward ? via_up_[arc] : via_down_[arc];
   const auto settled_sum = [&](Witness z) {
     // x→z→y upward, y→z→x downward, z below both (as unpack follows them).
     return upward ? add_cost(settle(z.to_tail, false, raised), settle(z.to_head, true, raised))
                   : add_cost(settle(z.to_head, false, raised), settle(z.to_tail, true, raised));
   };
   Derived best{input_cost(arc, upward), Witness{}};
-  if (!via.input()) {
-    const Witness z = via;
-    const double s = settled_sum(z);
-    if (s < best.weight) best = Derived{s, z};
+  if (!own.input()) {
+    const double s = settled_sum(own);
+    if (s < best.weight) best = Derived{s, own};
   }
   if (best.weight != w) {
     // The witness rose. Every weight is at most its triangles' sums and its input (a fall is
@@ -422,9 +422,7 @@ double CchMetric::settle(std::uint32_t arc, bool upward, std::vector<std::uint32
       const Derived c = candidates_[i];  // a copy: settling below pushes onto candidates_ too
       if (c.weight >= best.weight) break;
       // Its sides may have been raised since it was read, while settling others.
-      const double now = upward ? add_cost(down_[c.via.to_tail], up_[c.via.to_head])
-                                : add_cost(down_[c.via.to_head], up_[c.via.to_tail]);
-      if (now >= best.weight) continue;
+      if (side_sum(c.via, upward) >= best.weight) continue;
       const double s = settled_sum(c.via);
       if (s < best.weight) best = Derived{s, c.via};
     }
@@ -473,12 +471,11 @@ std::string CchMetric::invariant_violation() const {
         double witnessed = input_cost(arc, upward);
         if (!z.input()) {
           if (!is_triangle(arc, z)) return "arc " + std::to_string(arc) + "'s witness is not a triangle";
-          const std::uint32_t zx = z.to_tail, zy = z.to_head;
-          if (!known_exact(zx, !upward) || !known_exact(zy, upward)) {
+          if (!known_exact(z.to_tail, !upward) || !known_exact(z.to_head, upward)) {
             return "arc " + std::to_string(arc) + (upward ? " up" : " down") +
                    " is taken as exact over a side that is not";
           }
-          witnessed = upward ? add_cost(down_[zx], up_[zy]) : add_cost(down_[zy], up_[zx]);
+          witnessed = side_sum(z, upward);
         }
         if (witnessed != w) {
           return "arc " + std::to_string(arc) + (upward ? " up" : " down") + " is taken as exact at " +
@@ -502,7 +499,7 @@ std::string CchMetric::invariant_violation() const {
       if (z.input()) {
         if (input != kNoCchArc) witnessed = input_s(input);
       } else if (is_triangle(arc, z)) {
-        witnessed = upward ? add_cost(down_[z.to_tail], up_[z.to_head]) : add_cost(down_[z.to_head], up_[z.to_tail]);
+        witnessed = side_sum(z, upward);
       }
       if (witnessed != w) {
         return "arc " + std::to_string(arc) + (upward ? " up" : " down") + " weighs " + std::to_string(w) +

@@ -132,6 +132,10 @@ class CchMetric {
   void for_each_lower_triangle(std::uint32_t arc, bool upward, F&& f) const;
   // settle()'s triangles still to look at, one run per call on the recursion's stack.
   std::vector<Derived> candidates_;
+  // The sum over a triangle's sides today, the way asked: x→z→y upward, y→z→x downward.
+  [[nodiscard]] double side_sum(Witness w, bool upward) const {
+    return upward ? add_cost(down_[w.to_tail], up_[w.to_head]) : add_cost(down_[w.to_head], up_[w.to_tail]);
+  }
   // Whether `w` names two arcs {z, x} and {z, y} below arc {x, y}; for invariant_violation().
   [[nodiscard]] bool is_triangle(std::uint32_t arc, Witness w) const;
   // Which inputs the profile leaves open (kUp | kDown by arc), and the neighbour lists of the
