@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cassert>
+#include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -20,8 +22,10 @@ CchMetric::CchMetric(const CchTopology& topology, const TravelCost& cost, CchMet
       slot_(topology.arc_count(), 0),
       queue_(topology.arc_count()) {
   if (options_.lazy_rises) {
-    input_up_.resize(topology.arc_count());
-    input_down_.resize(topology.arc_count());
+    lazy_up_.resize(topology.arc_count());
+    lazy_down_.resize(topology.arc_count());
+    rival_up_.assign(topology.arc_count(), std::numeric_limits<float>::infinity());
+    rival_down_.assign(topology.arc_count(), std::numeric_limits<float>::infinity());
   }
   if (&topology.turns() != &cost.graph().turns()) {
     throw std::invalid_argument("the contraction hierarchy was built for another graph than the cost model's");
@@ -35,8 +39,9 @@ CchMetric::CchMetric(const CchTopology& topology, const TravelCost& cost, CchMet
     changed_below_.assign(topology.vertex_count(), batch_);
     parent_.resize(topology.vertex_count());
     for (std::uint32_t r = 0; r < topology.vertex_count(); ++r) parent_[r] = topology.parent(r);
-    exact_up_.assign(topology.arc_count(), batch_);
-    exact_down_.assign(topology.arc_count(), batch_);
+    for (auto* ways : {&lazy_up_, &lazy_down_}) {
+      for (LazyWay& w : *ways) w.exact = batch_;
+    }
   }
 }
 
@@ -47,6 +52,15 @@ void CchMetric::mark_changed(std::uint32_t arc) {
   for (std::uint32_t r = topology_->tail(arc); r != kNoCchArc && changed_below_[r] != batch_; r = parent_[r]) {
     changed_below_[r] = batch_;
   }
+}
+
+void CchMetric::lower_rival(std::uint32_t arc, bool upward, double s) {
+  float& rival = upward ? rival_up_[arc] : rival_down_[arc];
+  if (s >= static_cast<double>(rival)) return;
+  // The float at or below s: a bound rounded up could hide a cheaper way.
+  float f = static_cast<float>(s);
+  if (static_cast<double>(f) > s) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
+  rival = f;
 }
 
 double CchMetric::input_s(std::uint32_t index) const {
@@ -65,8 +79,8 @@ void CchMetric::customize_all(std::vector<std::uint8_t>& open) {
     up_[arc] = in.up == kNoCchArc ? kInfCost : input_s(in.up);
     down_[arc] = in.down == kNoCchArc ? kInfCost : input_s(in.down);
     if (options_.lazy_rises) {
-      input_up_[arc] = up_[arc];
-      input_down_[arc] = down_[arc];
+      lazy_up_[arc].input = up_[arc];
+      lazy_down_[arc].input = down_[arc];
     }
   }
   // Basic customization: every lower triangle {x, a, b} (x lowest) offers a→x→b and b→x→a. Going
@@ -93,13 +107,20 @@ void CchMetric::customize_all(std::vector<std::uint8_t>& open) {
         if (x_to_a_open && (open[xb] & kDown) != 0) open[ab] |= kDown;  // b→x→a
         const double up = add_cost(a_to_x, up_[xb]);
         const double down = add_cost(down_[xb], x_to_a);
+        // A lazy metric keeps the best of the ways that lost (lower_rival).
         if (up < up_[ab]) {
+          if (options_.lazy_rises) lower_rival(ab, true, up_[ab]);
           up_[ab] = up;
-          via_up_[ab] = Witness{xa, xb};
+          set_witness(ab, true, Witness{xa, xb}, x);
+        } else if (options_.lazy_rises) {
+          lower_rival(ab, true, up);
         }
         if (down < down_[ab]) {
+          if (options_.lazy_rises) lower_rival(ab, false, down_[ab]);
           down_[ab] = down;
-          via_down_[ab] = Witness{xa, xb};
+          set_witness(ab, false, Witness{xa, xb}, x);
+        } else if (options_.lazy_rises) {
+          lower_rival(ab, false, down);
         }
       }
     }
@@ -214,21 +235,26 @@ void CchMetric::queue(std::uint32_t arc, std::uint8_t derive) {
   queue_.push(arc);
 }
 
-void CchMetric::offer(std::uint32_t arc, bool upward, double old_s, double new_s, Witness via) {
+void CchMetric::offer(std::uint32_t arc, bool upward, double old_s, double new_s, Witness via, std::uint32_t middle) {
   const double current = upward ? up_[arc] : down_[arc];
+  const Witness own = witness(arc, upward);
+  if (options_.lazy_rises && own != via) {
+    // The way that loses, this triangle or the witness it replaces, costs at least `current`.
+    lower_rival(arc, upward, std::max(new_s, current));
+  }
   if (new_s < current) {
     queue(arc, 0);
     (upward ? up_[arc] : down_[arc]) = new_s;
-    (upward ? via_up_[arc] : via_down_[arc]) = via;
+    set_witness(arc, upward, via, middle);
   } else if (!options_.lazy_rises && new_s > old_s && old_s == current) {
     // The path through this triangle was (one of) the arc's cheapest and got dearer: only a full
     // look at its triangles tells its new weight.
     queue(arc, upward ? kUp : kDown);
-  } else if (options_.lazy_rises && new_s < old_s && (upward ? via_up_[arc] : via_down_[arc]) == via) {
+  } else if (options_.lazy_rises && new_s < old_s && own == via) {
     // The arc's own witness got cheaper and the weight did not move: the fall vanished in
     // rounding. The path under the weight changed all the same (a side took a new witness), so
     // the arc and every arc above it must be looked at again, as after a rise.
-    (upward ? exact_up_[arc] : exact_down_[arc]) = 0;
+    way(arc, upward).exact = 0;
     mark_changed(arc);
   }
 }
@@ -289,27 +315,31 @@ CustomizationStats CchMetric::propagate(std::vector<std::uint32_t>& changed) {
       if ((p.derive & (upward ? kUp : kDown)) == 0) continue;
       ++stats.recomputed;
       double& w = upward ? up_[arc] : down_[arc];
-      Witness& via = upward ? via_up_[arc] : via_down_[arc];
       if (options_.lazy_rises) {
         // Only a cheaper input can move a lower bound down; a dearer one waits for settle(), and
         // from now on every weight whose path may use it is stale (mark_changed).
         const std::uint32_t input = upward ? t.input(arc).up : t.input(arc).down;
         const double in = input == kNoCchArc ? kInfCost : input_s(input);
-        double& kept = upward ? input_up_[arc] : input_down_[arc];
-        if (in > kept) {
+        LazyWay& lw = way(arc, upward);
+        const bool by_input = witness(arc, upward).input();
+        if (in > lw.input) {
           mark_changed(arc);
           // A weight that is this input's cost is a real path's cost no longer.
-          if (via.input()) (upward ? exact_up_[arc] : exact_down_[arc]) = 0;
+          if (by_input) lw.exact = 0;
         }
-        kept = in;
+        lw.input = in;
         if (in < w) {
+          // The witness that loses stays a way to derive the weight, at or above the weight.
+          if (!by_input) lower_rival(arc, upward, w);
           w = in;
-          via = Witness{};
+          set_witness(arc, upward, Witness{}, kNoCchArc);
+        } else if (!by_input) {
+          lower_rival(arc, upward, in);
         }
       } else {
         const Derived d = derive(arc, upward);
         w = d.weight;
-        via = d.via;
+        (upward ? via_up_ : via_down_)[arc] = d.via;
       }
     }
     const bool up_moved = up_[arc] != p.old_up;      // x→y
@@ -322,8 +352,8 @@ CustomizationStats CchMetric::propagate(std::vector<std::uint32_t>& changed) {
       // that did not move is exact still: it lies at or below today's cost, and a fall can only
       // have lowered that cost from the one it was found exact at, which is the weight itself.
       // So a fall marks only the weights it moves, where a rise marks its whole subtree.
-      if (up_moved) exact_up_[arc] = 0;
-      if (down_moved) exact_down_[arc] = 0;
+      if (up_moved) lazy_up_[arc].exact = 0;
+      if (down_moved) lazy_down_[arc].exact = 0;
     }
     // {x, y} is a lower side of every triangle {x, y, z} with z above x; the triangle's arc
     // between y and z is offered y→x→z (riding on y→x) and z→x→y (riding on x→y). Only open
@@ -360,7 +390,7 @@ CustomizationStats CchMetric::propagate(std::vector<std::uint32_t>& changed) {
         if (side >= kInfCost) continue;
         // The arc {y, z}'s witness is x: its sides are {x, y} (this arc) and {x, z}.
         const Witness via = z > y ? Witness{arc, xz} : Witness{xz, arc};
-        offer(between(z, k, m), from_y == (z > y), add_cost(old_s, side), add_cost(new_s, side), via);
+        offer(between(z, k, m), from_y == (z > y), add_cost(old_s, side), add_cost(new_s, side), via, x);
       }
     };
     if (down_moved) offer_triangles(true, p.old_down, down_[arc]);
@@ -372,7 +402,7 @@ CustomizationStats CchMetric::propagate(std::vector<std::uint32_t>& changed) {
 
 void CchMetric::unpack(std::uint32_t arc, bool upward, std::vector<std::uint32_t>& out) const {
   const CchTopology& t = *topology_;
-  const Witness w = upward ? via_up_[arc] : via_down_[arc];
+  const Witness w = witness(arc, upward);
   if (w.input()) {
     out.push_back(t.vertex_at(upward ? t.head(arc) : t.tail(arc)));
     return;
@@ -393,47 +423,81 @@ double CchMetric::settle(std::uint32_t arc, bool upward, std::vector<std::uint32
   if (known_exact(arc, upward)) return w;
   // The weight's own witness first: settled, it is the cost of a real path, and where that equals
   // the weight (the common case) the lower bound is attained, so exact.
-  const Witness own = upward ? via_up_[arc] : via_down_[arc];
+  LazyWay& me = way(arc, upward);
+  const Witness own = witness(arc, upward);
+  if (!own.input()) {
+    // The second side is read after the first side's whole walk: ask for its state now.
+    // Upward x→z→y rides on {z, x} down and {z, y} up; downward on {z, y} down and {z, x} up.
+    __builtin_prefetch(&lazy_down_[upward ? own.to_tail : own.to_head]);
+    __builtin_prefetch(&lazy_up_[upward ? own.to_head : own.to_tail]);
+  }
   const auto settled_sum = [&](Witness z) {
     // x→z→y upward, y→z→x downward, z below both (as unpack follows them).
     return upward ? add_cost(settle(z.to_tail, false, raised), settle(z.to_head, true, raised))
                   : add_cost(settle(z.to_head, false, raised), settle(z.to_tail, true, raised));
   };
-  Derived best{input_cost(arc, upward), Witness{}};
+  Derived best{me.input, Witness{}};
+  double own_s = kInfCost;
   if (!own.input()) {
-    const double s = settled_sum(own);
-    if (s < best.weight) best = Derived{s, own};
+    own_s = settled_sum(own);
+    if (own_s < best.weight) best = Derived{own_s, own};
   }
-  if (best.weight != w) {
-    // The witness rose. Every weight is at most its triangles' sums and its input (a fall is
-    // carried up at once, a rise only raises them), so each triangle's sum today is a lower bound
-    // of its real cost. The triangles are read once, those below the best real path so far taken
-    // in order of their bounds, each settled; once the next bound is no lower than the best
-    // settled sum, no triangle can beat it. Settling raises weights only, so the bounds read
-    // stay bounds while the sides below them are settled.
+  float& rival = upward ? rival_up_[arc] : rival_down_[arc];
+  if (best.weight != w && best.weight > static_cast<double>(rival)) {
+    // The witness rose above another way's bound. Every weight is at most its triangles' sums and
+    // its input (a fall is carried up at once, a rise only raises them), so each triangle's sum
+    // today is a lower bound of its real cost. The triangles are read once, those below the best
+    // real path so far taken in order of their bounds, each settled; once the next bound is no
+    // lower than the best settled sum, no triangle can beat it. Settling raises weights only, so
+    // the bounds read stay bounds while the sides below them are settled. What loses is the
+    // arc's new rival.
+    double rest = own.input() ? kInfCost : best.via == own ? me.input : own_s;
     const std::size_t base = candidates_.size();
     for_each_lower_triangle(arc, upward, [&](double s, Witness z) {
-      if (s < best.weight) candidates_.push_back(Derived{s, z});
+      if (z == own) return;
+      if (s < best.weight) {
+        candidates_.push_back(Derived{s, z});
+      } else {
+        rest = std::min(rest, s);
+      }
     });
     std::sort(candidates_.begin() + static_cast<std::ptrdiff_t>(base), candidates_.end(),
               [](const Derived& a, const Derived& b) { return a.weight < b.weight; });
     const std::size_t end = candidates_.size();
     for (std::size_t i = base; i < end; ++i) {
       const Derived c = candidates_[i];  // a copy: settling below pushes onto candidates_ too
-      if (c.weight >= best.weight) break;
+      if (c.weight >= best.weight) {
+        rest = std::min(rest, c.weight);  // the least of the bounds not looked at
+        break;
+      }
       // Its sides may have been raised since it was read, while settling others.
-      if (side_sum(c.via, upward) >= best.weight) continue;
+      const double bound = side_sum(c.via, upward);
+      if (bound >= best.weight) {
+        rest = std::min(rest, bound);
+        continue;
+      }
       const double s = settled_sum(c.via);
-      if (s < best.weight) best = Derived{s, c.via};
+      if (s < best.weight) {
+        rest = std::min(rest, best.weight);
+        best = Derived{s, c.via};
+      } else {
+        rest = std::min(rest, s);
+      }
     }
     candidates_.resize(base);
-    assert(best.weight >= w);
-    // A tie through another witness moves no weight: nothing for the planner to repair.
-    if (best.weight != w) raised.push_back(arc);
-    w = best.weight;
-    (upward ? via_up_[arc] : via_down_[arc]) = best.via;
+    rival = std::numeric_limits<float>::infinity();
+    lower_rival(arc, upward, rest);
+  } else if (best.via != own) {
+    // The input won over the witness's triangle, which is a rival from now on.
+    lower_rival(arc, upward, own_s);
   }
-  (upward ? exact_up_[arc] : exact_down_[arc]) = batch_;
+  assert(best.weight >= w);
+  // A tie through another witness moves no weight: nothing for the planner to repair. The witness
+  // moves all the same, so that the weight is its witness's cost.
+  if (best.weight != w) raised.push_back(arc);
+  w = best.weight;
+  if (best.via != own) set_witness(arc, upward, best.via, best.via.input() ? kNoCchArc : topology_->tail(best.via.to_tail));
+  me.exact = batch_;
   return w;
 }
 
@@ -462,12 +526,29 @@ std::string CchMetric::invariant_violation() const {
         return "arc " + std::to_string(arc) + " holds " + std::to_string(up_[arc]) + "/" + std::to_string(down_[arc]) +
                " above what its triangles give, " + std::to_string(up) + "/" + std::to_string(down);
       }
+      // The rival bounds every other way: the input where the witness is a triangle, and every
+      // open lower triangle but the witness.
+      for (const bool upward : {true, false}) {
+        const double rival = upward ? rival_up_[arc] : rival_down_[arc];
+        const Witness z = witness(arc, upward);
+        if (way(arc, upward).middle != (z.input() ? kNoCchArc : t.tail(z.to_tail))) {
+          return "arc " + std::to_string(arc) + (upward ? " up" : " down") + " keeps a middle not its witness's";
+        }
+        double other = z.input() ? kInfCost : input_cost(arc, upward);
+        for_each_lower_triangle(arc, upward, [&](double sum, Witness tri) {
+          if (tri != z) other = std::min(other, sum);
+        });
+        if (rival > other) {
+          return "arc " + std::to_string(arc) + (upward ? " up" : " down") + " has rival bound " +
+                 std::to_string(rival) + " above another way's " + std::to_string(other);
+        }
+      }
       // A weight settle() would take as exact without looking is its witness's sum, over sides
       // it would take as exact too: so, by induction, the cost of the path it unpacks to.
       for (const bool upward : {true, false}) {
         if (!known_exact(arc, upward)) continue;
         const double w = upward ? up_[arc] : down_[arc];
-        const Witness z = upward ? via_up_[arc] : via_down_[arc];
+        const Witness z = witness(arc, upward);
         double witnessed = input_cost(arc, upward);
         if (!z.input()) {
           if (!is_triangle(arc, z)) return "arc " + std::to_string(arc) + "'s witness is not a triangle";
@@ -493,7 +574,7 @@ std::string CchMetric::invariant_violation() const {
     for (const bool upward : {true, false}) {
       const double w = upward ? up_[arc] : down_[arc];
       if (w >= kInfCost) continue;
-      const Witness z = upward ? via_up_[arc] : via_down_[arc];
+      const Witness z = witness(arc, upward);
       const std::uint32_t input = upward ? in.up : in.down;
       double witnessed = kInfCost;
       if (z.input()) {
@@ -511,11 +592,9 @@ std::string CchMetric::invariant_violation() const {
 }
 
 std::size_t CchMetric::memory_bytes() const {
-  return (up_.size() + down_.size() + input_up_.size() + input_down_.size()) * sizeof(double) +
-         (via_up_.size() + via_down_.size()) * sizeof(Witness) +
-         (slot_.size() + changed_below_.size() + parent_.size() + exact_up_.size() +
-          exact_down_.size()) *
-             sizeof(std::uint32_t) +
+  return (up_.size() + down_.size()) * sizeof(double) + (via_up_.size() + via_down_.size()) * sizeof(Witness) +
+         (lazy_up_.size() + lazy_down_.size()) * sizeof(LazyWay) + (rival_up_.size() + rival_down_.size()) * sizeof(float) +
+         (slot_.size() + changed_below_.size() + parent_.size()) * sizeof(std::uint32_t) +
          queue_.memory_bytes() +
          pending_.capacity() * sizeof(Pending) +
          [&] {

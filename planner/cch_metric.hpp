@@ -15,6 +15,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -115,8 +116,8 @@ class CchMetric {
   static constexpr std::uint8_t kUp = 1, kDown = 2;
   void queue(std::uint32_t arc, std::uint8_t derive);
   // Triangle {x, y, z} offers `arc` (one of its upper sides) new_s in place of old_s, in one
-  // direction.
-  void offer(std::uint32_t arc, bool upward, double old_s, double new_s, Witness via);
+  // direction; `middle` is its lowest vertex.
+  void offer(std::uint32_t arc, bool upward, double old_s, double new_s, Witness via, std::uint32_t middle);
   void queue_turns_into(std::uint32_t turn_vertex);
   void queue_turns_out_of(std::uint32_t turn_vertex);
   // The weight a lower-triangle scan and the input give arc `arc` now in one direction, with its
@@ -153,6 +154,14 @@ class CchMetric {
   // than the triangle's middle, so that neither searches the middle's arc list for them.
   std::vector<Witness> via_up_;
   std::vector<Witness> via_down_;
+  [[nodiscard]] const Witness& witness(std::uint32_t arc, bool upward) const {
+    return (upward ? via_up_ : via_down_)[arc];
+  }
+  // Sets a witness; `middle` is its triangle's lowest vertex z (tail(w.to_tail)), or kNoCchArc.
+  void set_witness(std::uint32_t arc, bool upward, Witness w, std::uint32_t middle) {
+    (upward ? via_up_ : via_down_)[arc] = w;
+    if (options_.lazy_rises) way(arc, upward).middle = middle;
+  }
   // A vertex's neighbours through open arc directions, each list ascending by neighbour: a CSR
   // per kind, indexed by rank. For a vertex v and a lower neighbour z: lower_out holds z where
   // v→z is open, lower_in where z→v is; upper_out and upper_in the same for higher neighbours.
@@ -191,12 +200,31 @@ class CchMetric {
   std::uint32_t batch_ = 1;
   std::vector<std::uint32_t> changed_below_;           // by rank: the batch of the last input rise in its subtree
   std::vector<std::uint32_t> parent_;                  // by rank: the topology's parent(), in one array for the climb
-  std::vector<std::uint32_t> exact_up_, exact_down_;  // by arc: the batch its weight was last found exact in
-  // Lazy rises: each input's cost as of the last change reported for it. A rise is told from a
-  // fall by it, and settle() reads it instead of the graph and the overlay.
-  std::vector<double> input_up_, input_down_;
+  // Lazy rises: what settle() reads of one arc direction to decide whether to look further, side
+  // by side: the walk visits arcs scattered over a metric far larger than the cache (over 100 MB
+  // on Porto), and an arc known exact then costs one line. (Weights, witnesses and rivals stay in
+  // arrays of their own: customization offers to runs of neighbouring arcs, which pack densely.)
+  struct alignas(16) LazyWay {
+    // The input's cost as of the last change reported for it. A rise is told from a fall by it,
+    // and settle() reads it instead of the graph and the overlay.
+    double input = kInfCost;
+    std::uint32_t exact = 0;           // the batch the weight was last found exact in
+    std::uint32_t middle = kNoCchArc;  // the witness's middle z, or kNoCchArc for the input
+  };
+  std::vector<LazyWay> lazy_up_, lazy_down_;
+  // Lazy rises: a lower bound of every other way to derive each weight (the input where the
+  // witness is a triangle, and every open lower triangle but the witness), rounded down to a
+  // float. Where the witness rose and its new sum is no dearer, the witness holds, and settle()
+  // need not read the arc's triangles (on Porto's slowest replans, about half the scans). Falls
+  // lower it as they are offered; rises only leave it lower than it could be.
+  std::vector<float> rival_up_, rival_down_;
+  [[nodiscard]] LazyWay& way(std::uint32_t arc, bool upward) { return (upward ? lazy_up_ : lazy_down_)[arc]; }
+  [[nodiscard]] const LazyWay& way(std::uint32_t arc, bool upward) const {
+    return (upward ? lazy_up_ : lazy_down_)[arc];
+  }
+  void lower_rival(std::uint32_t arc, bool upward, double s);
   [[nodiscard]] double input_cost(std::uint32_t arc, bool upward) const {
-    if (options_.lazy_rises) return upward ? input_up_[arc] : input_down_[arc];
+    if (options_.lazy_rises) return way(arc, upward).input;
     const std::uint32_t input = upward ? topology_->input(arc).up : topology_->input(arc).down;
     return input == kNoCchArc ? kInfCost : input_s(input);
   }
@@ -206,10 +234,9 @@ class CchMetric {
   // below the arc's ends; its sides' witnesses lie below z in turn), so only a rise below z can
   // have changed its cost. A weight that is its input's cost is reset (0) when that input rises.
   [[nodiscard]] bool known_exact(std::uint32_t arc, bool upward) const {
-    const std::uint32_t exact = upward ? exact_up_[arc] : exact_down_[arc];
-    if (exact == 0) return false;
-    const Witness& w = upward ? via_up_[arc] : via_down_[arc];
-    return w.input() || exact >= changed_below_[topology_->tail(w.to_tail)];
+    const LazyWay& w = way(arc, upward);
+    if (w.exact == 0) return false;
+    return w.middle == kNoCchArc || w.exact >= changed_below_[w.middle];
   }
   const void* settler_ = nullptr;
 };
