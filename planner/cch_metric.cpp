@@ -236,21 +236,27 @@ void CchMetric::queue(std::uint32_t arc, std::uint8_t derive) {
 }
 
 void CchMetric::offer(std::uint32_t arc, bool upward, double old_s, double new_s, Witness via, std::uint32_t middle) {
-  const double current = upward ? up_[arc] : down_[arc];
-  const Witness own = witness(arc, upward);
-  if (options_.lazy_rises && own != via) {
-    // The way that loses, this triangle or the witness it replaces, costs at least `current`.
-    lower_rival(arc, upward, std::max(new_s, current));
+  double& current = upward ? up_[arc] : down_[arc];
+  if (!options_.lazy_rises) {
+    if (new_s < current) {
+      queue(arc, 0);
+      current = new_s;
+      set_witness(arc, upward, via, middle);
+    } else if (new_s > old_s && old_s == current) {
+      // The path through this triangle was (one of) the arc's cheapest and got dearer: only a
+      // full look at its triangles tells its new weight.
+      queue(arc, upward ? kUp : kDown);
+    }
+    return;
   }
+  const Witness own = witness(arc, upward);
+  // The way that loses, this triangle or the witness it replaces, costs at least `current`.
+  if (own != via) lower_rival(arc, upward, std::max(new_s, current));
   if (new_s < current) {
     queue(arc, 0);
-    (upward ? up_[arc] : down_[arc]) = new_s;
+    current = new_s;
     set_witness(arc, upward, via, middle);
-  } else if (!options_.lazy_rises && new_s > old_s && old_s == current) {
-    // The path through this triangle was (one of) the arc's cheapest and got dearer: only a full
-    // look at its triangles tells its new weight.
-    queue(arc, upward ? kUp : kDown);
-  } else if (options_.lazy_rises && new_s < old_s && own == via) {
+  } else if (new_s < old_s && own == via) {
     // The arc's own witness got cheaper and the weight did not move: the fall vanished in
     // rounding. The path under the weight changed all the same (a side took a new witness), so
     // the arc and every arc above it must be looked at again, as after a rise.
@@ -321,7 +327,7 @@ CustomizationStats CchMetric::propagate(std::vector<std::uint32_t>& changed) {
         const std::uint32_t input = upward ? t.input(arc).up : t.input(arc).down;
         const double in = input == kNoCchArc ? kInfCost : input_s(input);
         LazyWay& lw = way(arc, upward);
-        const bool by_input = witness(arc, upward).input();
+        const bool by_input = lw.middle == kNoCchArc;  // the witness is the input (set_witness)
         if (in > lw.input) {
           mark_changed(arc);
           // A weight that is this input's cost is a real path's cost no longer.
@@ -425,12 +431,6 @@ double CchMetric::settle(std::uint32_t arc, bool upward, std::vector<std::uint32
   // the weight (the common case) the lower bound is attained, so exact.
   LazyWay& me = way(arc, upward);
   const Witness own = witness(arc, upward);
-  if (!own.input()) {
-    // The second side is read after the first side's whole walk: ask for its state now.
-    // Upward x→z→y rides on {z, x} down and {z, y} up; downward on {z, y} down and {z, x} up.
-    __builtin_prefetch(&lazy_down_[upward ? own.to_tail : own.to_head]);
-    __builtin_prefetch(&lazy_up_[upward ? own.to_head : own.to_tail]);
-  }
   const auto settled_sum = [&](Witness z) {
     // x→z→y upward, y→z→x downward, z below both (as unpack follows them).
     return upward ? add_cost(settle(z.to_tail, false, raised), settle(z.to_head, true, raised))
