@@ -72,7 +72,7 @@ double CchMetric::input_s(std::uint32_t index) const {
   return turn >= kInfCost ? kInfCost : add_cost(turn, cost_->transit_s(onto));
 }
 
-void CchMetric::customize_all(std::vector<std::uint8_t>& open) {
+void CchMetric::customize_all(HugePageVector<std::uint8_t>& open) {
   const CchTopology& t = *topology_;
   for (std::uint32_t arc = 0; arc < t.arc_count(); ++arc) {
     const CchTopology::Input& in = t.input(arc);
@@ -127,7 +127,7 @@ void CchMetric::customize_all(std::vector<std::uint8_t>& open) {
   }
 }
 
-std::vector<std::uint8_t> CchMetric::open_inputs() const {
+HugePageVector<std::uint8_t> CchMetric::open_inputs() const {
   const CchTopology& t = *topology_;
   // An input direction is open unless the profile closes it for good: a restriction or U-turn
   // rule (turn_s), or an edge the vehicle does not fit. The overlay is not read.
@@ -136,7 +136,7 @@ std::vector<std::uint8_t> CchMetric::open_inputs() const {
     const maps::TurnArc& a = t.turn_arc(index);
     return cost_->turn_s(a) < kInfCost && !cost_->blocked(t.turns().edge_of(a.other));
   };
-  std::vector<std::uint8_t> open(t.arc_count(), 0);
+  HugePageVector<std::uint8_t> open(t.arc_count(), 0);
   for (std::uint32_t arc = 0; arc < t.arc_count(); ++arc) {
     const CchTopology::Input& in = t.input(arc);
     open[arc] = static_cast<std::uint8_t>((input_open(in.up) ? kUp : 0) | (input_open(in.down) ? kDown : 0));
@@ -146,7 +146,7 @@ std::vector<std::uint8_t> CchMetric::open_inputs() const {
 
 void CchMetric::build_open_lists() {
   const CchTopology& t = *topology_;
-  const std::vector<std::uint8_t>& open = open_;
+  const HugePageVector<std::uint8_t>& open = open_;
   // The four neighbour lists, by counting. Arc ids ascend by tail and, within a tail, by head, so
   // filling in id order keeps every list ascending.
   const std::size_t n = t.vertex_count();

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "planner/cch_topology.hpp"
+#include "planner/huge_page_allocator.hpp"
 #include "planner/rising_id_queue.hpp"
 #include "planner/travel_cost.hpp"
 
@@ -106,7 +107,7 @@ class CchMetric {
  private:
   // Full customization; also closes `open` (kUp | kDown by arc, the open inputs on entry) under
   // the triangles, so that it ends holding every arc direction some path can drive.
-  void customize_all(std::vector<std::uint8_t>& open);
+  void customize_all(HugePageVector<std::uint8_t>& open);
   // Settles queued arcs in rank order of their lower end. An arc that changed offers its new
   // value through every triangle it is a lower side of: a cheaper path lowers the arc above at
   // once; a rise where the old value was the arc's minimum queues it to be re-derived.
@@ -141,19 +142,19 @@ class CchMetric {
   [[nodiscard]] bool is_triangle(std::uint32_t arc, Witness w) const;
   // Which inputs the profile leaves open (kUp | kDown by arc), and the neighbour lists of the
   // open directions once customize_all has closed them under the triangles.
-  [[nodiscard]] std::vector<std::uint8_t> open_inputs() const;
+  [[nodiscard]] HugePageVector<std::uint8_t> open_inputs() const;
   void build_open_lists();
 
   const CchTopology* topology_;
   const TravelCost* cost_;
   CchMetricOptions options_;
-  std::vector<double> up_;
-  std::vector<double> down_;
+  HugePageVector<double> up_;
+  HugePageVector<double> down_;
   // Each weight's witness: the two lower sides of the triangle whose sum it is, or none where it
   // is the input turn's cost. Unpacking a route and settling follow them; kept as arc ids rather
   // than the triangle's middle, so that neither searches the middle's arc list for them.
-  std::vector<Witness> via_up_;
-  std::vector<Witness> via_down_;
+  HugePageVector<Witness> via_up_;
+  HugePageVector<Witness> via_down_;
   [[nodiscard]] const Witness& witness(std::uint32_t arc, bool upward) const {
     return (upward ? via_up_ : via_down_)[arc];
   }
@@ -167,21 +168,21 @@ class CchMetric {
   // v→z is open, lower_in where z→v is; upper_out and upper_in the same for higher neighbours.
   // CchDownArc::tail holds the neighbour, lower or higher.
   struct OpenLists {
-    std::vector<std::uint32_t> first;
-    std::vector<CchDownArc> entries;  // {neighbour, arc}
+    HugePageVector<std::uint32_t> first;
+    HugePageVector<CchDownArc> entries;  // {neighbour, arc}
     [[nodiscard]] std::span<const CchDownArc> of(std::uint32_t r) const {
       return {entries.data() + first[r], first[r + 1] - first[r]};
     }
   };
   OpenLists lower_out_, lower_in_, upper_out_, upper_in_;
-  std::vector<std::uint8_t> open_;  // by arc: kUp | kDown where open
+  HugePageVector<std::uint8_t> open_;  // by arc: kUp | kDown where open
   // One queued arc: its weights before this round, and which directions must be re-derived.
   struct Pending {
     double old_up;
     double old_down;
     std::uint8_t derive;
   };
-  std::vector<std::uint32_t> slot_;     // by arc: 1 + its index in pending_, or 0 when not queued
+  HugePageVector<std::uint32_t> slot_;     // by arc: 1 + its index in pending_, or 0 when not queued
   std::vector<Pending> pending_;
   // The queued arcs, taken in id order: ids follow the lower end's rank, and an arc only ever
   // queues arcs with higher lower ends.
@@ -198,8 +199,8 @@ class CchMetric {
   // p50 and p99 by 5–10 %; reading the mark at the witness's middle rather than at the arc's
   // lower end (a subtree that holds the arc's every triangle) left 35 % fewer arcs to walk.
   std::uint32_t batch_ = 1;
-  std::vector<std::uint32_t> changed_below_;           // by rank: the batch of the last input rise in its subtree
-  std::vector<std::uint32_t> parent_;                  // by rank: the topology's parent(), in one array for the climb
+  HugePageVector<std::uint32_t> changed_below_;           // by rank: the batch of the last input rise in its subtree
+  HugePageVector<std::uint32_t> parent_;                  // by rank: the topology's parent(), in one array for the climb
   // Lazy rises: what settle() reads of one arc direction to decide whether to look further, side
   // by side: the walk visits arcs scattered over a metric far larger than the cache (over 100 MB
   // on Porto), and an arc known exact then costs one line. (Weights, witnesses and rivals stay in
@@ -211,13 +212,13 @@ class CchMetric {
     std::uint32_t exact = 0;           // the batch the weight was last found exact in
     std::uint32_t middle = kNoCchArc;  // the witness's middle z, or kNoCchArc for the input
   };
-  std::vector<LazyWay> lazy_up_, lazy_down_;
+  HugePageVector<LazyWay> lazy_up_, lazy_down_;
   // Lazy rises: a lower bound of every other way to derive each weight (the input where the
   // witness is a triangle, and every open lower triangle but the witness), rounded down to a
   // float. Where the witness rose and its new sum is no dearer, the witness holds, and settle()
   // need not read the arc's triangles (on Porto's slowest replans, about half the scans). Falls
   // lower it as they are offered; rises only leave it lower than it could be.
-  std::vector<float> rival_up_, rival_down_;
+  HugePageVector<float> rival_up_, rival_down_;
   [[nodiscard]] LazyWay& way(std::uint32_t arc, bool upward) { return (upward ? lazy_up_ : lazy_down_)[arc]; }
   [[nodiscard]] const LazyWay& way(std::uint32_t arc, bool upward) const {
     return (upward ? lazy_up_ : lazy_down_)[arc];
