@@ -1,21 +1,29 @@
-// One mission's search graph on a customizable contraction hierarchy: the arcs an upward search
-// from the start and a downward search to the goal can use, with the virtual start S and goal G of
-// SearchSpace. S, and every vertex of the upward half, reaches G at its true cost over the turn
-// graph (at a lower bound of it, on a metric with lazy rises: planner/settled_replan.hpp): a
-// cheapest path goes up from the start through the elimination tree's ancestors of the start, then
-// down through those of the goal (Dibbelt, Strasser & Wagner 2016, §6). Other vertices' values are
-// upper bounds at best: only cost_to_goal and the route are meaningful. This is D* Lite's graph at
-// metro scale: a few thousand vertices around two elimination-tree paths instead of the whole
-// city.
+// One mission's search graph on a customizable contraction hierarchy, with the virtual start S and
+// goal G of SearchSpace. A cheapest path over the turn graph goes up from the start through the
+// elimination tree's ancestors of the start (the upward half), then down through those of the
+// goal (the downward half), meeting at a vertex of both (Dibbelt, Strasser & Wagner 2016, §6).
+// This is D* Lite's graph at metro scale: a few hundred vertices around the goal's elimination-tree
+// path instead of the whole city.
+//
+// The goal never moves, so D* Lite keeps its backward tree over the downward half and repairs it
+// as costs change. The start moves with the vehicle and takes a new upward half whenever it
+// crosses into a new subtree, so the upward half is not part of D* Lite's graph: S's arcs are
+// the cheapest upward paths from the start to each meeting vertex, found by one sweep up the
+// half in rank order (its arcs all point up, so each vertex is final before it is read). On Porto
+// a raise near the top of the upward half re-derived most of it through D* Lite's raise
+// cascade, twice per vertex and with every successor read each time; the sweep reads each arc
+// once (docs/routing.md). S and every vertex of the downward half reach G at their true cost
+// (on a metric with lazy rises, a lower bound of it: planner/settled_replan.hpp); only
+// cost_to_goal and the route are meaningful.
 //
 // Vertices are CCH ranks (planner/cch_topology.hpp), then S, then G. The arcs:
-//   S → the start points' vertices (the rest of the start edge), and S → G on one edge;
-//   x → y for every CCH arc with x below y, x an ancestor of a start vertex and x→y open for the
-//   profile (planner/cch_metric.hpp; weight x→y);
+//   S → m for every meeting vertex m (in both halves) that an upward path reaches, and S → G on
+//   one edge;
 //   y → x for every CCH arc with x below y, x an ancestor of a goal vertex and y→x open (weight y→x);
 //   x → G for every turn onto a goal edge from x (the turn, then the goal edge up to the goal).
-// When the vehicle moves, the start's ancestors change: move_starts reports the vertices whose
-// arcs came or went, and D* Lite repairs them like any cost change.
+// S's arcs change when the vehicle moves, its start edge's conditions change (refresh_start), or
+// an arc of the upward half changes weight (arcs_changed); D* Lite re-derives S like any vertex
+// whose arcs changed.
 #pragma once
 
 #include <algorithm>
@@ -27,13 +35,16 @@
 
 namespace corridor::planner {
 
-// The arc a route takes out of a vertex: from S onto a start edge, up or down a CCH arc (to be
-// unpacked), onto the goal edge into G, or S to G along one edge.
+// The arc a route takes out of a vertex: from S along a start edge and up the upward half to a
+// meeting vertex, down a CCH arc (to be unpacked), onto the goal edge into G, or S to G along one
+// edge.
 struct CchVia {
-  enum class Kind : std::uint8_t { start, up, down, goal, direct };
+  enum class Kind : std::uint8_t { start, down, goal, direct };
   Kind kind = Kind::start;
+  // down: the CCH arc. start: the meeting vertex's place in the upward half (the path up to it is
+  // the sweep's, CchSearchSpace::for_each_arc_up).
   std::uint32_t arc = kNoCchArc;
-  EdgeId edge;
+  EdgeId edge;  // start, goal, direct: the edge
 };
 
 class CchSearchSpace {
@@ -45,26 +56,26 @@ class CchSearchSpace {
   CchSearchSpace(const CchMetric& metric, std::vector<EdgePoint> starts, std::vector<EdgePoint> goals);
 
   [[nodiscard]] std::size_t vertex_count() const { return n_ + 2; }
-  // The most arcs a path from S to G can take without visiting a vertex twice: S, the two halves,
-  // G. A greedy walk over stale values that goes on longer is going round in circles.
-  [[nodiscard]] std::size_t max_path_arcs() const { return up_set_.size() + down_set_.size() + 2; }
+  // The most arcs a path from S to G can take without visiting a vertex twice: S's, the downward
+  // half, G's. A greedy walk over stale values that goes on longer is going round in circles.
+  [[nodiscard]] std::size_t max_path_arcs() const { return down_set_.size() + 2; }
   [[nodiscard]] Vertex start() const { return Vertex{static_cast<std::uint32_t>(n_)}; }
   [[nodiscard]] Vertex goal() const { return Vertex{static_cast<std::uint32_t>(n_ + 1)}; }
   // No heuristic: the graph is small, and the key modifier never moves.
   [[nodiscard]] double h_from_start_s(Vertex) const { return 0.0; }
 
-  // The vehicle moved: S's arcs change, and so does the upward half of the graph. Returns the
-  // key modifier's increase (0 without a heuristic); rewired() then lists the vertices whose
-  // arcs came or went.
+  // The vehicle moved: a new upward half where it crossed into another subtree, and new costs of
+  // S's arcs in any case. Returns the key modifier's increase (0 without a heuristic).
   double move_starts(std::vector<EdgePoint> starts);
-  [[nodiscard]] std::span<const Vertex> rewired() const { return rewired_; }
+  // A start edge's conditions changed: S's arcs cost what the start edges cost today.
+  void refresh_start();
 
   [[nodiscard]] const CchMetric& metric() const { return *metric_; }
   [[nodiscard]] std::span<const EdgePoint> starts() const { return flat_.starts(); }
   [[nodiscard]] std::span<const EdgePoint> goals() const { return flat_.goals(); }
   [[nodiscard]] bool is_start_edge(EdgeId e) const { return flat_.is_start_edge(e); }
   // The vertices whose arcs an edge's conditions enter directly: the turns into G over a goal
-  // edge (the CCH arcs change through the metric: for_each_vertex_on_arc).
+  // edge (the CCH arcs change through the metric: vertices_on_arcs).
   template <class F>
   void for_each_vertex_turning_onto(EdgeId e, F&& f) const {
     for (const Target& t : targets_) {
@@ -78,34 +89,30 @@ class CchSearchSpace {
       if (metric_->cost().graph().tail(goals()[t.goal].edge) == n) f(Vertex{t.rank});
     }
   }
-  // The vertices whose arcs use CCH arc `arc` (whose weight the metric changed).
-  template <class F>
-  void for_each_vertex_on_arc(std::uint32_t arc, F&& f) const {
-    const std::uint32_t x = topology_->tail(arc);
-    if (metric_->open(arc, true) && in_up(x)) f(Vertex{x});
-    if (metric_->open(arc, false) && in_down(x)) f(Vertex{topology_->head(arc)});
-  }
-  // The same for a batch of arcs, each vertex once, in ascending order, into `out` (cleared). A
-  // batch sorted by id (as the metric hands them out) is read only where the mission's vertices'
-  // arcs lie: a city-wide batch holds thousands of arcs, a mission's graph a few hundred vertices.
+  // The vertices whose arcs use a batch of CCH arcs (whose weights the metric changed), each once,
+  // in ascending order, into `out` (cleared): the downward half's vertices above an arc of the
+  // batch, and S when an arc of the upward half is in it. A batch sorted by id (as the metric
+  // hands them out) is read only where the mission's vertices' arcs lie: a city-wide batch holds
+  // thousands of arcs, a mission's graph a few hundred vertices.
   void vertices_on_arcs(std::span<const std::uint32_t> arcs, std::vector<Vertex>& out) const;
+  // The metric changed these arcs' weights: takes the upward half's new weights, derives S's arcs
+  // again where they moved, and lists the vertices whose arcs changed as vertices_on_arcs does
+  // (S only where an upward weight moved).
+  void arcs_changed(std::span<const std::uint32_t> arcs, std::vector<Vertex>& out);
 
   // f(Vertex to, double cost_s, Via via) for every arc out of u.
   template <class F>
   void for_each_successor(Vertex u, F&& f) const {
     if (u == start()) {
-      for (const EdgePoint& s : starts()) {
-        f(Vertex{topology_->rank(s.vertex())}, cost().partial_time_s(s.edge, s.offset_m, length_m(s.edge)),
-          Via{Via::Kind::start, kNoCchArc, s.edge});
+      for (const Meeting& m : meetings_) {
+        const double c = add_cost(start_shift_s_, up_cost_[m.place]);
+        if (c < kInfCost) f(Vertex{m.rank}, c, Via{Via::Kind::start, m.place, EdgeId{}});
       }
       for_each_direct([&](double c, EdgeId e) { f(goal(), c, Via{Via::Kind::direct, kNoCchArc, e}); });
       return;
     }
     if (u == goal()) return;
     const std::uint32_t r = u.v;
-    if (in_up(r)) {
-      for (const CchDownArc& a : metric_->upper_out(r)) f(Vertex{a.tail}, metric_->up_s(a.arc), Via{Via::Kind::up, a.arc, EdgeId{}});
-    }
     for (const CchDownArc& d : down_out(r)) f(Vertex{d.tail}, metric_->down_s(d.arc), Via{Via::Kind::down, d.arc, EdgeId{}});
     for_each_target_arc(r, [&](double c, EdgeId e) { f(goal(), c, Via{Via::Kind::goal, kNoCchArc, e}); });
   }
@@ -120,13 +127,25 @@ class CchSearchSpace {
       return;
     }
     const std::uint32_t r = v.v;
-    for (const CchDownArc& d : up_in(r)) f(Vertex{d.tail}, metric_->up_s(d.arc));
-    if (in_down(r)) {
-      for (const CchDownArc& a : metric_->upper_in(r)) f(Vertex{a.tail}, metric_->down_s(a.arc));
+    if (!in_down(r)) return;
+    for (const CchDownArc& a : metric_->upper_in(r)) f(Vertex{a.tail}, metric_->down_s(a.arc));
+    const auto m = std::lower_bound(meetings_.begin(), meetings_.end(), r,
+                                    [](const Meeting& x, std::uint32_t rank) { return x.rank < rank; });
+    if (m != meetings_.end() && m->rank == r) {
+      const double c = add_cost(start_shift_s_, up_cost_[m->place]);
+      if (c < kInfCost) f(start(), c);
     }
-    for (const EdgePoint& s : starts()) {
-      if (topology_->rank(s.vertex()) == r) f(start(), cost().partial_time_s(s.edge, s.offset_m, length_m(s.edge)));
-    }
+  }
+
+  // f(arc, upward) for every hierarchy arc a route takes along `via`: a down arc, or the upward
+  // path of a start via, from the start up.
+  template <class F>
+  void for_each_hierarchy_arc(const Via& via, F&& f) const {
+    if (via.kind == Via::Kind::down) f(via.arc, false);
+    if (via.kind != Via::Kind::start) return;
+    std::vector<std::uint32_t> arcs;
+    climb(via.arc, arcs);
+    for (auto it = arcs.rbegin(); it != arcs.rend(); ++it) f(*it, true);
   }
 
   // The route along these arcs from S to G, shortcuts unpacked into the turns they stand for.
@@ -146,27 +165,39 @@ class CchSearchSpace {
     std::uint32_t goal;
     std::uint32_t turn;
   };
+  // A vertex of both halves: S's arcs end there.
+  struct Meeting {
+    std::uint32_t rank;
+    std::uint32_t place;  // in the upward half
+  };
+  // An arc of the upward half, filed under its higher end: its lower end's place, and its id.
+  struct UpArc {
+    std::uint32_t tail_place;
+    std::uint32_t arc;
+  };
+  // How the sweep reached a vertex of the upward half: by `arc` from the vertex at place `from`,
+  // or (from = kNoCchArc) from S along start point `arc`.
+  struct Step {
+    std::uint32_t from = kNoCchArc;
+    std::uint32_t arc = kNoCchArc;
+  };
+  // A start point's vertex: its place in the upward half, and what S's arc to it costs.
+  struct Seed {
+    std::uint32_t place;
+    std::uint32_t start;  // index into starts()
+    double cost_s;
+  };
   [[nodiscard]] const TravelCost& cost() const { return metric_->cost(); }
   [[nodiscard]] double length_m(EdgeId e) const { return metric_->cost().graph().length_m(e); }
-  [[nodiscard]] bool in_up(std::uint32_t r) const { return std::binary_search(up_set_.begin(), up_set_.end(), r); }
   [[nodiscard]] bool in_down(std::uint32_t r) const {
     return std::binary_search(down_set_.begin(), down_set_.end(), r);
   }
-  // Upward arcs into r from the members below it (r in the upward half), downward arcs out of r
-  // to the members below it (r in the downward half); empty when r is not in that half.
-  [[nodiscard]] std::span<const CchDownArc> up_in(std::uint32_t r) const {
-    return filed_under(r, up_set_, up_first_, up_arcs_);
-  }
+  // Downward arcs out of r to the members below it (r in the downward half); empty otherwise.
   [[nodiscard]] std::span<const CchDownArc> down_out(std::uint32_t r) const {
-    return filed_under(r, down_set_, down_first_, down_arcs_);
-  }
-  static std::span<const CchDownArc> filed_under(std::uint32_t r, const std::vector<std::uint32_t>& set,
-                                                 const std::vector<std::uint32_t>& first,
-                                                 const std::vector<CchDownArc>& arcs) {
-    const auto it = std::lower_bound(set.begin(), set.end(), r);
-    if (it == set.end() || *it != r) return {};
-    const auto i = static_cast<std::size_t>(it - set.begin());
-    return {arcs.data() + first[i], first[i + 1] - first[i]};
+    const auto it = std::lower_bound(down_set_.begin(), down_set_.end(), r);
+    if (it == down_set_.end() || *it != r) return {};
+    const auto i = static_cast<std::size_t>(it - down_set_.begin());
+    return {down_arcs_.data() + down_first_[i], down_first_[i + 1] - down_first_[i]};
   }
   [[nodiscard]] double target_cost_s(const Target& t) const;
   template <class F>
@@ -182,11 +213,27 @@ class CchSearchSpace {
       }
     }
   }
-  // Builds a half from its members (the ancestors of its vertices, ascending), filing the arcs
-  // between members under their higher end (the upward half enters it by them, the downward half
-  // leaves by them). Only arcs open in the half's direction are filed.
-  void build_half(std::vector<std::uint32_t> members, bool upward, std::vector<std::uint32_t>& set,
-                  std::vector<std::uint32_t>& first, std::vector<CchDownArc>& arcs) const;
+  // The downward half from its members (the goal vertices' ancestors, ascending): the arcs between
+  // members open downward, filed under their higher end, which leaves by them.
+  void build_down(std::vector<std::uint32_t> members);
+  // The upward half from its members (the start vertices' ancestors, ascending): the arcs between
+  // members open upward, filed under their higher end, with their weights; and the meeting
+  // vertices.
+  void build_up(std::vector<std::uint32_t> members);
+  // The start points' costs today. One start point seeds the sweep at 0, and its cost is added to
+  // S's arcs (start_shift_s_), so that driving along the edge moves no sweep; several seed it
+  // at their costs. True when the sweep must run again.
+  bool seed();
+  // Derives the cheapest upward paths again from place `from` up: the vertices below it kept
+  // theirs, as no arc into them changed.
+  void sweep(std::size_t from);
+  // Appends the upward arcs of the sweep's path to the vertex at `place` to `out`, from there
+  // down; returns the start point the path leaves S by.
+  std::uint32_t climb(std::uint32_t place, std::vector<std::uint32_t>& out) const;
+  // f(place of the arc's tail, arc) for every arc of the batch open upward in the upward half,
+  // and out gets the downward half's vertices above an arc of the batch (unsorted, repeated).
+  template <class F>
+  void scan_batch(std::span<const std::uint32_t> arcs, std::vector<Vertex>& out, F&& on_up_arc) const;
 
   const CchMetric* metric_;
   const CchTopology* topology_;
@@ -194,11 +241,20 @@ class CchSearchSpace {
   SearchSpace flat_;  // the starts and goals, checked and clamped, and the route builder
   std::vector<Target> targets_;  // by rank
   std::vector<std::uint32_t> start_ranks_;  // the start vertices' ranks, ascending: the upward half's seeds
-  std::vector<std::uint32_t> up_set_, up_first_;
-  std::vector<CchDownArc> up_arcs_;
   std::vector<std::uint32_t> down_set_, down_first_;
   std::vector<CchDownArc> down_arcs_;
-  std::vector<Vertex> rewired_;
+  std::vector<std::uint32_t> up_set_, up_first_;
+  std::vector<UpArc> up_arcs_;
+  // The metric's weights of up_arcs_, as last reported (arcs_changed): the sweep reads them side
+  // by side instead of scattered over the metric.
+  std::vector<double> up_weight_s_;
+  std::vector<Meeting> meetings_;  // by rank
+  std::vector<Seed> seeds_;
+  double start_shift_s_ = 0.0;  // added to every S arc (one start point: its cost)
+  // The sweep: the cheapest upward path's cost from the seeds to each vertex of the upward half,
+  // and its last step.
+  std::vector<double> up_cost_;
+  std::vector<Step> up_step_;
 };
 
 }  // namespace corridor::planner

@@ -57,8 +57,6 @@ template <class Space>
 void BasicDStarLite<Space>::move_start(std::vector<EdgePoint> starts) {
   // km grows by h(s_last, s_start) so that keys already queued stay lower bounds (paper line 38'').
   km_ = add_cost(km_, space_.move_starts(std::move(starts)));
-  // On a CCH the move also adds and removes arcs of the upward half.
-  for (Vertex v : space_.rewired()) recompute_rhs(v);
   recompute_rhs(space_.start());
 }
 
@@ -72,7 +70,11 @@ void BasicDStarLite<Space>::edges_changed(std::span<const EdgeId> edges) {
     space_.for_each_vertex_turning_onto(e, [&](Vertex u) { recompute_rhs(u); });
     start_affected = start_affected || space_.is_start_edge(e);
   }
-  if (start_affected) recompute_rhs(space_.start());
+  if (start_affected) {
+    // On a CCH, S's arcs are upward paths from the start edges: derived again first.
+    if constexpr (std::is_same_v<Space, CchSearchSpace>) space_.refresh_start();
+    recompute_rhs(space_.start());
+  }
 }
 
 template <class Space>
@@ -84,7 +86,7 @@ void BasicDStarLite<Space>::arcs_changed(std::span<const std::uint32_t> arcs)
   // (`if constexpr` as well: clang instantiates this member for SearchSpace too, constraint or not.)
   if constexpr (std::is_same_v<Space, CchSearchSpace>) {
     std::vector<Vertex> touched;
-    space_.vertices_on_arcs(arcs, touched);
+    space_.arcs_changed(arcs, touched);
     for (Vertex u : touched) recompute_rhs(u);
   }
 }

@@ -63,8 +63,6 @@ class SearchSpace {
   // The vehicle moved (D* Lite): set_starts, and how far the heuristic can fall anywhere with it,
   // which D* Lite adds to its key modifier (start_shift_s from the old heads).
   double move_starts(std::vector<EdgePoint> starts);
-  // The vertices whose arcs a move adds or removes, beyond S's own: none on the turn graph.
-  [[nodiscard]] std::span<const Vertex> rewired() const { return {}; }
   // What the starts, goals and their nodes hold on the heap.
   [[nodiscard]] std::size_t heap_bytes() const {
     return (starts_.capacity() + goals_.capacity()) * sizeof(EdgePoint) +

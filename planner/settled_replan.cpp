@@ -18,9 +18,7 @@ SettledReplan replan_settled(CchMetric& metric, CchDStarLite& planner) {
   const auto settle_path = [&](const std::vector<CchVia>& path) {
     raised.clear();
     for (const CchVia& via : path) {
-      if (via.kind == CchVia::Kind::up || via.kind == CchVia::Kind::down) {
-        (void)metric.settle(via.arc, via.kind == CchVia::Kind::up, raised);
-      }
+      planner.space().for_each_hierarchy_arc(via, [&](std::uint32_t arc, bool upward) { (void)metric.settle(arc, upward, raised); });
     }
     if (raised.empty()) return false;
     std::sort(raised.begin(), raised.end());

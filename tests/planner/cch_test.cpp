@@ -254,7 +254,8 @@ TEST(CchMetric, ShortcutsUnpackIntoTurnsOfTheirWeight) {
 
 // A batch of moved arcs names the mission's vertices whose arcs use them, each once: read where
 // the mission's vertices lie when the batch is sorted (as the metric hands it out), arc by arc
-// otherwise, and both give exactly the vertices whose successor arcs include one of the batch.
+// otherwise, and both give exactly the downward half's vertices whose successor arcs include one
+// of the batch, and S where an upward path from the start can take one.
 TEST(CchSearchSpace, VerticesOnABatchOfArcsAreEachArcsOnce) {
   const GridHierarchy h(7, 12, 12);
   const auto& [g, overlay, cost, t, metric] = h;
@@ -274,9 +275,16 @@ TEST(CchSearchSpace, VerticesOnABatchOfArcsAreEachArcsOnce) {
     for (std::uint32_t v = 0; v < t.vertex_count(); ++v) {
       bool uses = false;
       space.for_each_successor(Vertex{v}, [&](Vertex, double, const CchVia& via) {
-        uses = uses || ((via.kind == CchVia::Kind::up || via.kind == CchVia::Kind::down) && in_batch.count(via.arc) > 0);
+        uses = uses || (via.kind == CchVia::Kind::down && in_batch.count(via.arc) > 0);
       });
       if (uses) expected.push_back(Vertex{v});
+    }
+    // S, when the batch holds an arc open upward out of an ancestor of the start vertex: one that
+    // an upward path from the start can take.
+    std::set<std::uint32_t> start_side;
+    for (std::uint32_t r = t.rank(space.starts()[0].vertex()); r != kNoCchArc; r = t.parent(r)) start_side.insert(r);
+    if (std::any_of(batch.begin(), batch.end(), [&](std::uint32_t arc) { return start_side.count(t.tail(arc)) > 0 && metric.open(arc, true); })) {
+      expected.push_back(space.start());
     }
     std::vector<Vertex> sorted_batch, shuffled_batch;
     space.vertices_on_arcs(batch, sorted_batch);
@@ -287,6 +295,79 @@ TEST(CchSearchSpace, VerticesOnABatchOfArcsAreEachArcsOnce) {
     found += static_cast<int>(expected.size());
   }
   EXPECT_GT(found, 500);
+}
+
+// S's arcs are the cheapest upward paths from the start to each meeting vertex: after every batch
+// of congestion, move and change of the start edge, the mission's arcs (kept up to date from the
+// lowest vertex whose arcs in moved) are those of a mission built afresh, each is the cost of the
+// upward arcs it names, and each is what relaxing every upward arc to a fixpoint gives.
+TEST(CchSearchSpace, StartArcsAreTheCheapestUpwardPathsWhileCostsChangeAndTheVehicleMoves) {
+  int compared = 0;
+  for (std::uint64_t seed = 1; seed <= 12; ++seed) {
+    GridHierarchy h(seed, 9, 10);
+    auto& [g, overlay, cost, t, metric] = h;
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    EdgePoint start = testing::random_point(g, rng);
+    const EdgePoint goal = testing::random_point(g, rng);
+    CchSearchSpace space(metric, {start}, {goal});
+    std::vector<Vertex> touched;
+    for (int step = 0; step < 40; ++step) {
+      std::vector<EdgeId> edges;
+      std::vector<NodeId> nodes;
+      random_batch(g, overlay, rng, 4, edges, nodes);
+      if (step % 5 == 0) {
+        edges.push_back(start.edge);
+        overlay.set_edge(start.edge, {1.0 + unit(rng) * 3.0, 0.0});
+      }
+      std::vector<std::uint32_t> changed;
+      metric.edges_changed(edges, changed);
+      metric.nodes_changed(nodes, changed);
+      space.arcs_changed(changed, touched);
+      if (std::find(edges.begin(), edges.end(), start.edge) != edges.end()) space.refresh_start();
+      // Along the same edge most of the time, now and then somewhere else.
+      start = unit(rng) < 0.7 ? EdgePoint{start.edge, std::min(g.length_m(start.edge), start.offset_m + unit(rng) * 20.0)}
+                              : testing::random_point(g, rng);
+      space.move_starts({start});
+
+      const CchSearchSpace fresh(metric, {start}, {goal});
+      std::vector<std::pair<Vertex, double>> kept, built;
+      space.for_each_successor(space.start(), [&](Vertex v, double c, const CchVia&) { kept.emplace_back(v, c); });
+      fresh.for_each_successor(fresh.start(), [&](Vertex v, double c, const CchVia&) { built.emplace_back(v, c); });
+      ASSERT_EQ(kept, built) << "seed " << seed << " step " << step;
+
+      // The oracle: every upward arc relaxed until nothing moves, from the start vertex.
+      std::vector<double> up(t.vertex_count(), kInfCost);
+      up[t.rank(start.vertex())] = cost.partial_time_s(start.edge, start.offset_m, g.length_m(start.edge));
+      for (bool moved = true; moved;) {
+        moved = false;
+        for (std::uint32_t arc = 0; arc < t.arc_count(); ++arc) {
+          if (!metric.open(arc, true)) continue;
+          const double c = add_cost(up[t.tail(arc)], metric.up_s(arc));
+          if (c < up[t.head(arc)] * (1.0 - 1e-12)) {
+            up[t.head(arc)] = c;
+            moved = true;
+          }
+        }
+      }
+      space.for_each_successor(space.start(), [&](Vertex v, double c, const CchVia& via) {
+        if (via.kind != CchVia::Kind::start) return;
+        EXPECT_NEAR(c, up[v.v], 1e-9 * std::max(1.0, c)) << "seed " << seed << " step " << step;
+        double along = cost.partial_time_s(start.edge, start.offset_m, g.length_m(start.edge));
+        std::uint32_t at = t.rank(start.vertex());
+        space.for_each_hierarchy_arc(via, [&](std::uint32_t arc, bool upward) {
+          EXPECT_TRUE(upward);
+          EXPECT_EQ(t.tail(arc), at);
+          at = t.head(arc);
+          along = add_cost(along, metric.up_s(arc));
+        });
+        EXPECT_EQ(at, v.v);
+        EXPECT_NEAR(along, c, 1e-9 * std::max(1.0, c));
+        ++compared;
+      });
+    }
+  }
+  EXPECT_GT(compared, 2000);
 }
 
 // The smallest map: one two-way street, two turn-graph vertices joined by the dead-end U-turns.
