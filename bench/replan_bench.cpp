@@ -194,7 +194,7 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
     res.cch_topology_bytes = topology->memory_bytes();
   }
   std::vector<double> t_cch_full, t_cch, t_cch_custom, t_cch_repair, t_cch0, cch_bytes;
-  double cch_changed = 0, cch_expanded = 0, cch_vertices = 0;
+  double cch_changed = 0, cch_expanded = 0, cch_vertices = 0, cch_searched = 0;
   std::vector<double> t_lazy, t_lazy_custom, t_lazy_repair, t_lazy_full;
   double lazy_changed = 0, lazy_repairs = 0, lazy_settled = 0;
   std::vector<double> lazy_bytes;
@@ -319,6 +319,7 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
         cch_changed += static_cast<double>(changed_arcs.size());
         cch_expanded += static_cast<double>(cch_stats.expanded);
         cch_vertices += static_cast<double>(cch_dstar->space().upward_size() + cch_dstar->space().downward_size());
+        cch_searched += static_cast<double>(cch_dstar->space().downward_size() + 2);
       }
 
       const planner::SearchSpace space(cost, {*position}, {goal});
@@ -392,6 +393,7 @@ ReplanBenchResult run_replan_bench(const maps::RoadGraph& graph, const ReplanBen
   res.cch_mean_changed_arcs = cch_changed / n;
   res.cch_mean_expanded = cch_expanded / n;
   res.cch_mean_vertices = cch_vertices / n;
+  res.cch_mean_searched_vertices = cch_searched / n;
   res.cch_bytes_per_planner = mean_of(cch_bytes);
   res.cch_max_bytes_per_planner = cch_bytes.empty() ? 0.0 : *std::max_element(cch_bytes.begin(), cch_bytes.end());
   res.lazy_dstar = summarize_ms(t_lazy);
@@ -505,6 +507,7 @@ nlohmann::json to_json(const ReplanBenchResult& r, const ReplanBenchConfig& c) {
   j["dstar_cch"]["mean_changed_arcs"] = r.cch_mean_changed_arcs;
   j["dstar_cch"]["mean_expanded"] = r.cch_mean_expanded;
   j["dstar_cch"]["mean_vertices"] = r.cch_mean_vertices;
+  j["dstar_cch"]["mean_searched_vertices"] = r.cch_mean_searched_vertices;
   j["dstar_cch"]["mean_bytes_per_planner"] = r.cch_bytes_per_planner;
   j["dstar_cch"]["max_bytes_per_planner"] = r.cch_max_bytes_per_planner;
   j["dstar_cch"]["mismatches"] = r.cch_mismatches;

@@ -98,7 +98,8 @@ struct ReplanBenchResult {
   LatencySummary cch_dstar, cch_customization, cch_repair, cch_dstar_initial;
   double cch_mean_changed_arcs = 0;      // arcs whose weight a batch moved
   double cch_mean_expanded = 0;
-  double cch_mean_vertices = 0;          // upward + downward half
+  double cch_mean_vertices = 0;          // the mission's slice: upward + downward half
+  double cch_mean_searched_vertices = 0;  // D* Lite's graph in it: the downward half, S and G
   double cch_bytes_per_planner = 0;
   double cch_max_bytes_per_planner = 0;
   std::size_t cch_mismatches = 0;

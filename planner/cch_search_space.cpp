@@ -1,5 +1,7 @@
 #include "planner/cch_search_space.hpp"
 
+#include <cassert>
+
 #include "planner/gallop.hpp"
 
 namespace corridor::planner {
@@ -167,6 +169,7 @@ double CchSearchSpace::move_starts(std::vector<EdgePoint> starts) {
 }
 
 std::uint32_t CchSearchSpace::climb(std::uint32_t place, std::vector<std::uint32_t>& out) const {
+  assert(up_cost_[place] < kInfCost);  // only a place the sweep reached has a path up to it
   for (Step s = up_step_[place]; s.from != kNoCchArc; s = up_step_[s.from]) out.push_back(s.arc);
   // The walk ends at a seed, whose step names its start point.
   for (;;) {

@@ -41,10 +41,10 @@ namespace corridor::planner {
 struct CchVia {
   enum class Kind : std::uint8_t { start, down, goal, direct };
   Kind kind = Kind::start;
-  // down: the CCH arc. start: the meeting vertex's place in the upward half (the path up to it is
-  // the sweep's, CchSearchSpace::for_each_arc_up).
+  // down: the CCH arc. start: the meeting vertex's place in the upward half (the path up to it,
+  // start edge included, is the sweep's: CchSearchSpace::for_each_hierarchy_arc, route_along).
   std::uint32_t arc = kNoCchArc;
-  EdgeId edge;  // start, goal, direct: the edge
+  EdgeId edge;  // goal, direct: the edge
 };
 
 class CchSearchSpace {
@@ -75,7 +75,7 @@ class CchSearchSpace {
   [[nodiscard]] std::span<const EdgePoint> goals() const { return flat_.goals(); }
   [[nodiscard]] bool is_start_edge(EdgeId e) const { return flat_.is_start_edge(e); }
   // The vertices whose arcs an edge's conditions enter directly: the turns into G over a goal
-  // edge (the CCH arcs change through the metric: vertices_on_arcs).
+  // edge (the CCH arcs change through the metric: arcs_changed).
   template <class F>
   void for_each_vertex_turning_onto(EdgeId e, F&& f) const {
     for (const Target& t : targets_) {
@@ -89,7 +89,7 @@ class CchSearchSpace {
       if (metric_->cost().graph().tail(goals()[t.goal].edge) == n) f(Vertex{t.rank});
     }
   }
-  // The vertices whose arcs use a batch of CCH arcs (whose weights the metric changed), each once,
+  // The vertices whose arcs can use a batch of CCH arcs, each once,
   // in ascending order, into `out` (cleared): the downward half's vertices above an arc of the
   // batch, and S when an arc of the upward half is in it. A batch sorted by id (as the metric
   // hands them out) is read only where the mission's vertices' arcs lie: a city-wide batch holds
@@ -138,14 +138,12 @@ class CchSearchSpace {
   }
 
   // f(arc, upward) for every hierarchy arc a route takes along `via`: a down arc, or the upward
-  // path of a start via, from the start up.
+  // path of a start via (in any order).
   template <class F>
   void for_each_hierarchy_arc(const Via& via, F&& f) const {
     if (via.kind == Via::Kind::down) f(via.arc, false);
     if (via.kind != Via::Kind::start) return;
-    std::vector<std::uint32_t> arcs;
-    climb(via.arc, arcs);
-    for (auto it = arcs.rbegin(); it != arcs.rend(); ++it) f(*it, true);
+    for (Step s = up_step_[via.arc]; s.from != kNoCchArc; s = up_step_[s.from]) f(s.arc, true);
   }
 
   // The route along these arcs from S to G, shortcuts unpacked into the turns they stand for.
@@ -181,7 +179,8 @@ class CchSearchSpace {
     std::uint32_t from = kNoCchArc;
     std::uint32_t arc = kNoCchArc;
   };
-  // A start point's vertex: its place in the upward half, and what S's arc to it costs.
+  // A start point's vertex: its place in the upward half, and what the sweep starts it at (the
+  // start edge's rest; 0 for a single start point, whose cost is start_shift_s_).
   struct Seed {
     std::uint32_t place;
     std::uint32_t start;  // index into starts()

@@ -2,7 +2,8 @@
 // searched backward from the goal and repaired incrementally as costs change and the vehicle moves.
 // One algorithm over two graphs: the turn graph itself (DStarLite, on SearchSpace), and one
 // mission's slice of a customizable contraction hierarchy (CchDStarLite, on CchSearchSpace), where
-// a metro-scale repair touches a few thousand vertices instead of a city.
+// a metro-scale repair touches a few hundred vertices (the goal's half of the slice) instead of a
+// city.
 // Optionally, raises (cost increases) are repaired lazily, as in Delayed D* (Ferguson & Stentz
 // 2005): only where they reach the vehicle's current path. Measured slower at metro scale (see
 // docs/routing.md), so off by default.
@@ -56,7 +57,8 @@ class BasicDStarLite {
   BasicDStarLite(const typename Space::Source& source, std::vector<EdgePoint> starts, std::vector<EdgePoint> goals,
                  DStarLiteOptions options = {});
 
-  // The vehicle has moved. Cheap: the repair happens in replan().
+  // The vehicle has moved. Cheap: the repair happens in replan() (on a hierarchy, S's arcs are
+  // derived here again: a sweep of the start's half).
   void move_start(std::vector<EdgePoint> starts);
   void edges_changed(std::span<const EdgeId> edges);
   void nodes_changed(std::span<const NodeId> nodes);
