@@ -54,6 +54,18 @@ void random_batch(const maps::RoadGraph& g, CostOverlay& overlay, std::mt19937_6
   }
 }
 
+// A random batch of `count` changes (random_batch), customized into `metric`: returns the arcs
+// whose weights moved; the edges changed are appended to `edges`.
+std::vector<std::uint32_t> customize_random_batch(const maps::RoadGraph& g, CostOverlay& overlay, std::mt19937_64& rng, int count,
+                                                  CchMetric& metric, std::vector<EdgeId>& edges) {
+  std::vector<NodeId> nodes;
+  random_batch(g, overlay, rng, count, edges, nodes);
+  std::vector<std::uint32_t> changed;
+  metric.edges_changed(edges, changed);
+  metric.nodes_changed(nodes, changed);
+  return changed;
+}
+
 // The contraction is a chordal supergraph of the turn graph: every turn has an arc, the higher
 // neighbours of a vertex are pairwise joined, and they all lie on its elimination-tree path.
 TEST(CchTopology, ContractionIsChordalAndHoldsEveryTurn) {
@@ -161,11 +173,7 @@ TEST(CchMetric, LazyRisesSettleToTheFullCustomization) {
     std::uniform_int_distribution<std::uint32_t> any_arc(0, static_cast<std::uint32_t>(t.arc_count() - 1));
     for (int batch = 0; batch < 30; ++batch) {
       std::vector<EdgeId> edges;
-      std::vector<NodeId> nodes;
-      random_batch(g, overlay, rng, 4, edges, nodes);
-      std::vector<std::uint32_t> changed;
-      lazy.edges_changed(edges, changed);
-      lazy.nodes_changed(nodes, changed);
+      std::vector<std::uint32_t> changed = customize_random_batch(g, overlay, rng, 4, lazy, edges);
       const CchMetric fresh(t, cost);
       for (std::uint32_t arc = 0; arc < t.arc_count(); ++arc) {
         ASSERT_LE(lazy.up_s(arc), fresh.up_s(arc)) << "seed " << seed << " batch " << batch << " arc " << arc;
@@ -367,11 +375,7 @@ TEST(CchSearchSpace, StartArcsAreTheCheapestUpwardPathsWhileCostsChangeAndTheVeh
     std::vector<Vertex> touched;
     for (int step = 0; step < 40; ++step) {
       std::vector<EdgeId> edges;
-      std::vector<NodeId> nodes;
-      random_batch(g, overlay, rng, 4, edges, nodes);
-      std::vector<std::uint32_t> changed;
-      metric.edges_changed(edges, changed);
-      metric.nodes_changed(nodes, changed);
+      std::vector<std::uint32_t> changed = customize_random_batch(g, overlay, rng, 4, metric, edges);
       space.arcs_changed(changed, touched);
       // A start edge in the batch: D* Lite's edges_changed re-derives S from the start edges.
       if (std::any_of(starts.begin(), starts.end(),
