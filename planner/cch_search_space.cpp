@@ -170,29 +170,20 @@ double CchSearchSpace::move_starts(std::vector<EdgePoint> starts) {
 
 std::uint32_t CchSearchSpace::climb(std::uint32_t place, std::vector<std::uint32_t>& out) const {
   assert(up_cost_[place] < kInfCost);  // only a place the sweep reached has a path up to it
-  for (Step s = up_step_[place]; s.from != kNoCchArc; s = up_step_[s.from]) out.push_back(s.arc);
   // The walk ends at a seed, whose step names its start point.
-  for (;;) {
-    const Step s = up_step_[place];
+  for (Step s = up_step_[place];; s = up_step_[s.from]) {
     if (s.from == kNoCchArc) return s.arc;
-    place = s.from;
+    out.push_back(s.arc);
   }
 }
 
 template <class F>
 void CchSearchSpace::scan_batch(std::span<const std::uint32_t> arcs, std::vector<Vertex>& out, F&& on_up_arc) const {
-  const auto place_in = [](const std::vector<std::uint32_t>& set, std::uint32_t r) {
-    const auto it = std::lower_bound(set.begin(), set.end(), r);
-    return it != set.end() && *it == r ? static_cast<std::uint32_t>(it - set.begin()) : kNoCchArc;
-  };
   if (!std::is_sorted(arcs.begin(), arcs.end())) {
     for (std::uint32_t arc : arcs) {
       const std::uint32_t x = topology_->tail(arc);
       if (metric_->open(arc, false) && in_down(x)) out.push_back(Vertex{topology_->head(arc)});
-      if (metric_->open(arc, true)) {
-        const std::uint32_t place = place_in(up_set_, x);
-        if (place != kNoCchArc) on_up_arc(place, arc);
-      }
+      if (metric_->open(arc, true) && std::binary_search(up_set_.begin(), up_set_.end(), x)) on_up_arc(arc);
     }
     return;
   }
@@ -200,25 +191,24 @@ void CchSearchSpace::scan_batch(std::span<const std::uint32_t> arcs, std::vector
   // Each half's members are ascending, so one forward pass over the batch serves each half.
   const auto scan = [&](const std::vector<std::uint32_t>& members, auto&& f) {
     auto it = arcs.begin();
-    for (std::uint32_t place = 0; place < members.size(); ++place) {
-      const std::uint32_t x = members[place];
+    for (std::uint32_t x : members) {
       it = std::lower_bound(it, arcs.end(), topology_->first_up(x));
       if (it == arcs.end()) return;
-      for (const std::uint32_t hi = topology_->first_up(x + 1); it != arcs.end() && *it < hi; ++it) f(place, *it);
+      for (const std::uint32_t hi = topology_->first_up(x + 1); it != arcs.end() && *it < hi; ++it) f(*it);
     }
   };
-  scan(down_set_, [&](std::uint32_t, std::uint32_t arc) {
+  scan(down_set_, [&](std::uint32_t arc) {
     if (metric_->open(arc, false)) out.push_back(Vertex{topology_->head(arc)});
   });
-  scan(up_set_, [&](std::uint32_t place, std::uint32_t arc) {
-    if (metric_->open(arc, true)) on_up_arc(place, arc);
+  scan(up_set_, [&](std::uint32_t arc) {
+    if (metric_->open(arc, true)) on_up_arc(arc);
   });
 }
 
 void CchSearchSpace::vertices_on_arcs(std::span<const std::uint32_t> arcs, std::vector<Vertex>& out) const {
   out.clear();
   bool upward_half = false;
-  scan_batch(arcs, out, [&](std::uint32_t, std::uint32_t) { upward_half = true; });
+  scan_batch(arcs, out, [&](std::uint32_t) { upward_half = true; });
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
   if (upward_half) out.push_back(start());
@@ -227,7 +217,7 @@ void CchSearchSpace::vertices_on_arcs(std::span<const std::uint32_t> arcs, std::
 void CchSearchSpace::arcs_changed(std::span<const std::uint32_t> arcs, std::vector<Vertex>& out) {
   out.clear();
   std::size_t lowest = up_set_.size();  // the lowest place whose arcs in moved
-  scan_batch(arcs, out, [&](std::uint32_t, std::uint32_t arc) {
+  scan_batch(arcs, out, [&](std::uint32_t arc) {
     const auto head = std::lower_bound(up_set_.begin(), up_set_.end(), topology_->head(arc));
     const auto place = static_cast<std::size_t>(head - up_set_.begin());
     // The head's arcs in ascend by id.

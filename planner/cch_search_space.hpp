@@ -229,7 +229,7 @@ class CchSearchSpace {
   // Appends the upward arcs of the sweep's path to the vertex at `place` to `out`, from there
   // down; returns the start point the path leaves S by.
   std::uint32_t climb(std::uint32_t place, std::vector<std::uint32_t>& out) const;
-  // f(place of the arc's tail, arc) for every arc of the batch open upward in the upward half,
+  // on_up_arc(arc) for every arc of the batch open upward in the upward half,
   // and out gets the downward half's vertices above an arc of the batch (unsorted, repeated).
   template <class F>
   void scan_batch(std::span<const std::uint32_t> arcs, std::vector<Vertex>& out, F&& on_up_arc) const;
