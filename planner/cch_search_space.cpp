@@ -83,14 +83,19 @@ void CchSearchSpace::build_up(std::vector<std::uint32_t> members) {
   up_arcs_.resize(up_first_.back());
   up_weight_s_.resize(up_first_.back());
   std::vector<std::uint32_t> fill(up_first_.begin(), up_first_.end() - 1);
-  std::size_t next = 0;
+  up_slot_.resize(heads.size());
+  up_out_first_.resize(up_set_.size() + 1);
+  std::uint32_t next = 0;
   for (std::uint32_t i = 0; i < up_set_.size(); ++i) {
+    up_out_first_[i] = next;
     for (const CchDownArc& a : metric_->upper_out(up_set_[i])) {
-      const std::uint32_t k = fill[heads[next++]]++;
+      const std::uint32_t k = fill[heads[next]]++;
+      up_slot_[next++] = k;
       up_arcs_[k] = {i, a.arc};
       up_weight_s_[k] = metric_->up_s(a.arc);
     }
   }
+  up_out_first_[up_set_.size()] = next;
   meetings_.clear();
   auto d = down_set_.begin();
   for (std::uint32_t i = 0; i < up_set_.size(); ++i) {
@@ -179,11 +184,27 @@ std::uint32_t CchSearchSpace::climb(std::uint32_t place, std::vector<std::uint32
 
 template <class F>
 void CchSearchSpace::scan_batch(std::span<const std::uint32_t> arcs, std::vector<Vertex>& out, F&& on_up_arc) const {
+  // Arc `arc`, open upward, of the member at `place`: its entry among the member's open upward
+  // arcs, which ascend by id, from `j` on.
+  const auto slot_of = [&](std::uint32_t place, std::uint32_t arc, std::size_t& j) {
+    const auto outs = metric_->upper_out(up_set_[place]);
+    while (outs[j].arc < arc) ++j;
+    assert(outs[j].arc == arc);
+    return up_slot_[up_out_first_[place] + j];
+  };
   if (!std::is_sorted(arcs.begin(), arcs.end())) {
     for (std::uint32_t arc : arcs) {
       const std::uint32_t x = topology_->tail(arc);
       if (metric_->open(arc, false) && in_down(x)) out.push_back(Vertex{topology_->head(arc)});
-      if (metric_->open(arc, true) && std::binary_search(up_set_.begin(), up_set_.end(), x)) on_up_arc(arc);
+      if (!metric_->open(arc, true)) continue;
+      const auto it = std::lower_bound(up_set_.begin(), up_set_.end(), x);
+      if (it == up_set_.end() || *it != x) continue;
+      const auto place = static_cast<std::uint32_t>(it - up_set_.begin());
+      const auto outs = metric_->upper_out(x);
+      std::size_t j = static_cast<std::size_t>(
+          std::lower_bound(outs.begin(), outs.end(), arc, [](const CchDownArc& a, std::uint32_t id) { return a.arc < id; }) -
+          outs.begin());
+      on_up_arc(arc, place, slot_of(place, arc, j));
     }
     return;
   }
@@ -191,24 +212,26 @@ void CchSearchSpace::scan_batch(std::span<const std::uint32_t> arcs, std::vector
   // Each half's members are ascending, so one forward pass over the batch serves each half.
   const auto scan = [&](const std::vector<std::uint32_t>& members, auto&& f) {
     auto it = arcs.begin();
-    for (std::uint32_t x : members) {
+    for (std::uint32_t place = 0; place < members.size(); ++place) {
+      const std::uint32_t x = members[place];
       it = std::lower_bound(it, arcs.end(), topology_->first_up(x));
       if (it == arcs.end()) return;
-      for (const std::uint32_t hi = topology_->first_up(x + 1); it != arcs.end() && *it < hi; ++it) f(*it);
+      std::size_t j = 0;  // the member's own cursor, for the upward half's slots
+      for (const std::uint32_t hi = topology_->first_up(x + 1); it != arcs.end() && *it < hi; ++it) f(*it, place, j);
     }
   };
-  scan(down_set_, [&](std::uint32_t arc) {
+  scan(down_set_, [&](std::uint32_t arc, std::uint32_t, std::size_t&) {
     if (metric_->open(arc, false)) out.push_back(Vertex{topology_->head(arc)});
   });
-  scan(up_set_, [&](std::uint32_t arc) {
-    if (metric_->open(arc, true)) on_up_arc(arc);
+  scan(up_set_, [&](std::uint32_t arc, std::uint32_t place, std::size_t& j) {
+    if (metric_->open(arc, true)) on_up_arc(arc, place, slot_of(place, arc, j));
   });
 }
 
 void CchSearchSpace::vertices_on_arcs(std::span<const std::uint32_t> arcs, std::vector<Vertex>& out) const {
   out.clear();
   bool upward_half = false;
-  scan_batch(arcs, out, [&](std::uint32_t) { upward_half = true; });
+  scan_batch(arcs, out, [&](std::uint32_t, std::uint32_t, std::uint32_t) { upward_half = true; });
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
   if (upward_half) out.push_back(start());
@@ -217,16 +240,15 @@ void CchSearchSpace::vertices_on_arcs(std::span<const std::uint32_t> arcs, std::
 void CchSearchSpace::arcs_changed(std::span<const std::uint32_t> arcs, std::vector<Vertex>& out) {
   out.clear();
   std::size_t lowest = up_set_.size();  // the lowest place whose arcs in moved
-  scan_batch(arcs, out, [&](std::uint32_t arc) {
-    const auto head = std::lower_bound(up_set_.begin(), up_set_.end(), topology_->head(arc));
-    const auto place = static_cast<std::size_t>(head - up_set_.begin());
-    // The head's arcs in ascend by id.
-    const auto first = up_arcs_.begin() + up_first_[place], last = up_arcs_.begin() + up_first_[place + 1];
-    const auto k = std::lower_bound(first, last, arc, [](const UpArc& a, std::uint32_t id) { return a.arc < id; });
-    double& w = up_weight_s_[static_cast<std::size_t>(k - up_arcs_.begin())];
-    if (w == metric_->up_s(arc)) return;
-    w = metric_->up_s(arc);
-    lowest = std::min(lowest, place);
+  scan_batch(arcs, out, [&](std::uint32_t arc, std::uint32_t place, std::uint32_t slot) {
+    double& w = up_weight_s_[slot];
+    const double now = metric_->up_s(arc);
+    if (w == now) return;
+    w = now;
+    // The head lies above the tail's place; where that is at or above `lowest` it cannot lower it.
+    if (place + 1 >= lowest) return;
+    const auto head = std::lower_bound(up_set_.begin() + place + 1, up_set_.end(), topology_->head(arc));
+    lowest = std::min(lowest, static_cast<std::size_t>(head - up_set_.begin()));
   });
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
@@ -270,7 +292,8 @@ Route CchSearchSpace::route_along(const std::vector<Via>& vias) const {
 }
 
 std::size_t CchSearchSpace::heap_bytes() const {
-  return flat_.heap_bytes() + (start_ranks_.capacity() + up_set_.capacity() + up_first_.capacity() + down_set_.capacity() + down_first_.capacity()) *
+  return flat_.heap_bytes() + (start_ranks_.capacity() + up_set_.capacity() + up_first_.capacity() + up_slot_.capacity() + up_out_first_.capacity() +
+                              down_set_.capacity() + down_first_.capacity()) *
                              sizeof(std::uint32_t) +
          up_arcs_.capacity() * sizeof(UpArc) + down_arcs_.capacity() * sizeof(CchDownArc) + targets_.capacity() * sizeof(Target) +
          meetings_.capacity() * sizeof(Meeting) + seeds_.capacity() * sizeof(Seed) +
