@@ -104,6 +104,14 @@ void register_bench_command(CLI::App& app) {
       ->capture_default_str();
   serve->add_option("--client-threads", s->second.client_threads, "load generator threads")->capture_default_str();
   serve->add_option("--server-threads", s->second.server_threads, "server I/O threads")->capture_default_str();
+  serve->add_option("--repair-threads", s->second.repair_threads,
+                    "threads repairing plans after a congestion batch, its request's I/O thread included (0 = as many as "
+                    "--server-threads)")
+      ->capture_default_str();
+  serve->add_option("--repair-priority", s->second.repair_realtime_priority,
+                    "0, or the real-time (SCHED_FIFO) priority of repairs, as serve's --repair-priority")
+      ->check(CLI::Range(0, 99))
+      ->capture_default_str();
   add_planner_graph_option(*serve, s->second.planner_graph);
   serve->callback([s] {
     const maps::RoadGraph graph = load_map_from_options(s->first);

@@ -29,6 +29,7 @@ struct ServeOptions {
   std::string listen = "127.0.0.1:8080";
   std::string config;
   int threads = 2;
+  int repair_priority = 0;
   bool demo = false;
   server::PlannerGraph planner_graph = server::PlannerGraph::automatic;
 };
@@ -91,6 +92,7 @@ void run_serve(const ServeOptions& o) {
   const std::filesystem::path map_file = o.map.map_file.empty() ? CORRIDOR_DEFAULT_MAP : o.map.map_file;
   server::DispatchConfig dispatch;
   dispatch.repair_threads = o.threads;  // as many as serve requests
+  dispatch.repair_realtime_priority = o.repair_priority;
   dispatch.planner_graph = o.planner_graph;
   server::DispatchService service(graph, maps::signal_plans_for(map_file, graph), dispatch, &store, now());
   std::vector<server::StaticAsset> console;
@@ -167,6 +169,11 @@ void register_serve_command(CLI::App& app) {
   cmd->add_option("--listen", o->listen, "HOST:PORT to listen on (port 0 picks a free one)")->capture_default_str();
   cmd->add_option("--config", o->config, "JSON config: tokens with roles, limits");
   cmd->add_option("--threads", o->threads, "I/O threads; as many repair plans in parallel after a congestion change")->capture_default_str();
+  cmd->add_option("--repair-priority", o->repair_priority,
+                  "0, or the real-time (SCHED_FIFO) priority repairs after a congestion change run at, so other "
+                  "work cannot preempt them (needs root or CAP_SYS_NICE; docs/routing.md)")
+      ->check(CLI::Range(0, 99))
+      ->capture_default_str();
   add_planner_graph_option(*cmd, o->planner_graph);
   cmd->add_flag("--demo", o->demo,
                  "drive simulated vehicles along their missions' routes, and now and then congest a route ahead");

@@ -200,16 +200,17 @@ json histogram_from_metrics(const std::string& text, const std::string& name, co
 
 json run_serve_bench(const maps::RoadGraph& graph, const ServeBenchConfig& c) {
   if (c.vehicles < 1 || c.missions < 0 || c.missions > c.vehicles || c.seconds <= 0 || c.client_threads < 1 ||
-      c.congestion_requests_per_s < 1 || c.rate_per_s < 0 || !std::isfinite(c.rate_per_s)) {
-    throw std::invalid_argument("bench serve: need vehicles >= missions >= 0, seconds > 0, threads >= 1, rate >= 0");
+      c.congestion_requests_per_s < 1 || c.repair_threads < 0 || c.repair_threads > 64 || c.rate_per_s < 0 || !std::isfinite(c.rate_per_s)) {
+    throw std::invalid_argument("bench serve: need vehicles >= missions >= 0, seconds > 0, threads >= 1, repair threads 0..64, rate >= 0");
   }
   const auto db = std::filesystem::temp_directory_path() / ("corridor-bench-" + std::to_string(::getpid()) + ".db");
   std::filesystem::remove(db);
   server::Store store(db);
   const auto now = [] { return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count(); };
   server::DispatchConfig dispatch;
-  dispatch.repair_threads = c.server_threads;
+  dispatch.repair_threads = c.repair_threads > 0 ? c.repair_threads : c.server_threads;
   dispatch.planner_graph = c.planner_graph;
+  dispatch.repair_realtime_priority = c.repair_realtime_priority;
   server::DispatchService service(graph, dispatch, &store, now());
   server::TokenAuth auth;
   auth.add(kToken, {"bench", server::kAllRoles, std::nullopt});
@@ -336,7 +337,14 @@ json run_serve_bench(const maps::RoadGraph& graph, const ServeBenchConfig& c) {
     out["hierarchy"] = {{"arcs", h->topology().arc_count()}, {"arcs_per_vertex", h->density()}, {"shared_bytes", h->memory_bytes()}};
   }
   out["config"] = {{"vehicles", c.vehicles}, {"missions", c.missions}, {"congestion_edges_per_s", c.congestion_edges_per_s},
-                   {"seconds", c.seconds}, {"rate_per_s", c.rate_per_s}, {"client_threads", c.client_threads}, {"server_threads", c.server_threads}};
+                   {"seconds", c.seconds}, {"rate_per_s", c.rate_per_s}, {"client_threads", c.client_threads}, {"server_threads", c.server_threads},
+                   {"repair_threads", dispatch.repair_threads}, {"repair_priority", c.repair_realtime_priority}};
+  // Whether the real-time priority asked for was granted (null: not asked).
+  if (const auto granted = service.repair_realtime_granted()) {
+    out["config"]["repair_priority_granted"] = *granted;
+  } else {
+    out["config"]["repair_priority_granted"] = nullptr;
+  }
   // In-process server and load generator: the resident set is both, the mission delta the server's.
   out["memory"] = {{"rss_mb_before_missions", rss_before_missions},
                    {"rss_mb_with_missions", rss_with_missions},

@@ -21,6 +21,10 @@ struct ServeBenchConfig {
   double rate_per_s = 0.0;
   int client_threads = 1;
   int server_threads = 2;
+  // Threads that repair plans after a congestion batch, the request's own I/O thread included;
+  // 0 = as many as server_threads.
+  int repair_threads = 0;
+  int repair_realtime_priority = 0;  // DispatchConfig's
   server::PlannerGraph planner_graph = server::PlannerGraph::automatic;
   std::uint64_t seed = 1;
 };

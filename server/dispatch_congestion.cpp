@@ -5,6 +5,7 @@
 
 #include <boost/asio/post.hpp>
 #include <boost/asio/thread_pool.hpp>
+#include <spdlog/spdlog.h>
 
 #include <time.h>
 
@@ -14,6 +15,7 @@
 #include <latch>
 
 #include "server/dispatch_mission.hpp"
+#include "server/realtime_scope.hpp"
 
 namespace corridor::server {
 
@@ -183,6 +185,15 @@ CongestionResult DispatchService::repair_plans(const std::vector<MissionPtr>& mi
   std::mutex merge_mutex;
   std::exception_ptr failure;
   const auto drain = [&] {
+    // Only while it repairs: between batches the thread serves requests like any other.
+    const RealtimeScope realtime(config_.repair_realtime_priority);
+    if (config_.repair_realtime_priority > 0) {
+      const Realtime now = realtime.granted() ? Realtime::granted : Realtime::denied;
+      if (repair_realtime_.exchange(now) != now && now == Realtime::denied) {
+        spdlog::warn("event=repair_priority_denied priority={} hint=\"needs root, CAP_SYS_NICE or RLIMIT_RTPRIO; repairs run at normal priority\"",
+                     config_.repair_realtime_priority);
+      }
+    }
     CongestionResult mine;
     std::vector<std::shared_ptr<CommitTicket>> tickets;
     try {

@@ -13,6 +13,7 @@
 #include "planner/snap_points.hpp"
 #include "preemption/signal_costs.hpp"
 #include "server/dispatch_mission.hpp"
+#include "server/realtime_scope.hpp"
 
 namespace corridor::server {
 
@@ -78,6 +79,10 @@ DispatchService::DispatchService(const maps::RoadGraph& graph, std::unordered_ma
       preemption_(graph, plans_, signals_, config.preemption) {
   if (config_.repair_threads < 1 || config_.repair_threads > 64) {
     throw std::invalid_argument("repair_threads must be 1 to 64, not " + std::to_string(config_.repair_threads));
+  }
+  if (config_.repair_realtime_priority < 0 || config_.repair_realtime_priority > max_realtime_priority()) {
+    throw std::invalid_argument("repair_realtime_priority must be 0 (off) to " + std::to_string(max_realtime_priority()) +
+                                ", not " + std::to_string(config_.repair_realtime_priority));
   }
   // Every mission's lights are preempted, so each movement through a light with a plan costs its
   // expected transition (the rule the SUMO loop uses too); a signal without a plan keeps the flat
@@ -613,6 +618,15 @@ PositionResult DispatchService::report_position(const PositionReport& p, double 
 std::size_t DispatchService::active_mission_count() const {
   std::shared_lock lock(registry_mutex_);
   return active_by_vehicle_.size();
+}
+
+std::optional<bool> DispatchService::repair_realtime_granted() const {
+  switch (repair_realtime_.load()) {
+    case Realtime::granted: return true;
+    case Realtime::denied: return false;
+    case Realtime::not_asked: break;
+  }
+  return std::nullopt;
 }
 
 // Runs in the constructor, before the service is shared: no locks needed.

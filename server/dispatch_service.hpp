@@ -5,6 +5,7 @@
 // durable. Transport-free, so request handling can be tested and fuzzed without sockets.
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <functional>
 #include <map>
@@ -52,6 +53,13 @@ struct DispatchConfig {
   double signal_delay_s = 15.0;    // expected delay at a signalized intersection without a plan, for routing
   // Threads that repair missions' plans after a congestion change, the calling one included.
   int repair_threads = 2;
+  // 0, or the SCHED_FIFO priority (1..99) the repair threads take while they repair a congestion
+  // batch. A repair costs under 1 ms of CPU, but on a machine whose cores are shared with position
+  // reports and the commit queue it waits for them mid-repair: on 2 cores, Porto, 200 missions,
+  // 2,000 positions/s, 2-3 % of repairs took over 2 ms of wall time, none with priority 1. The
+  // price is position acknowledgements held behind the batch (docs/routing.md). Needs root,
+  // CAP_SYS_NICE or RLIMIT_RTPRIO; without them the threads keep their scheduling, with a warning.
+  int repair_realtime_priority = 0;
   PlannerGraph planner_graph = PlannerGraph::automatic;
   // Arcs per vertex above which `automatic` keeps the turn graph: road networks measure 6 to 10, a
   // city-wide grid about 30, where customizing a batch costs 20x more (docs/routing.md).
@@ -101,6 +109,9 @@ class DispatchService {
   // "program", and the program step; a simulator mirrors these onto its own lights.
   [[nodiscard]] std::pair<std::string, std::size_t> signal_mode(NodeId node) const;
   [[nodiscard]] std::size_t active_mission_count() const;
+  // Whether a repair thread got the real-time priority it was configured with: nullopt until one
+  // has asked (or when none is configured).
+  [[nodiscard]] std::optional<bool> repair_realtime_granted() const;
   // The graph the missions are planned on (never `automatic`), and the hierarchy when it is that.
   [[nodiscard]] PlannerGraph planner_graph() const { return hierarchy_ ? PlannerGraph::hierarchy : PlannerGraph::turn_graph; }
   [[nodiscard]] const SharedHierarchy* hierarchy() const { return hierarchy_.get(); }
@@ -215,6 +226,8 @@ class DispatchService {
   std::uint64_t update_sequence_ = 0;
 
   std::unique_ptr<boost::asio::thread_pool> repair_pool_;  // null with one repair thread
+  enum class Realtime : int { not_asked, granted, denied };
+  std::atomic<Realtime> repair_realtime_{Realtime::not_asked};
 
   mutable std::mutex listeners_mutex_;
   std::map<std::size_t, Listener> listeners_;

@@ -197,8 +197,28 @@ assert r["count"] > 0, r
 shares = [b["share"] for b in r["share_within"]]
 assert shares == sorted(shares) and shares[-1] == 1.0, shares
 assert r["p99_at_most_ms"] is not None and r["p99_at_most_ms"] <= 1000, r
+cfg = j["config"]
+assert cfg["repair_threads"] == cfg["server_threads"] == 2 and cfg["repair_priority"] == 0, cfg
+assert cfg["repair_priority_granted"] is None, cfg  # nothing asked for
 PY
 then pass; else fail "bench serve output: $(head -c 400 "$work/serve.json")"; fi
+# With one repair thread at real-time priority: asked for, granted or not (the machine's rights),
+# and the run is as complete.
+"$corridor" bench serve --seconds 1 --rate 300 --vehicles 10 --missions 5 --congestion-edges-per-s 300 \
+  --repair-threads 1 --repair-priority 2 > "$work/serve_rt.json" 2> /dev/null
+if python3 - "$work/serve_rt.json" <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert j["errors"] == 0, j["errors"]
+cfg = j["config"]
+assert cfg["repair_threads"] == 1 and cfg["server_threads"] == 2 and cfg["repair_priority"] == 2, cfg
+assert cfg["repair_priority_granted"] in (True, False), cfg
+assert j["congestion"]["mission_replans"]["count"] > 0, j["congestion"]
+PY
+then pass; else fail "bench serve --repair-priority output: $(head -c 400 "$work/serve_rt.json")"; fi
+expect_error "not in range" "$corridor" bench serve --seconds 1 --repair-priority 100
+expect_error "not in range" "$corridor" serve --repair-priority -1
+expect_error "repair threads 0..64" "$corridor" bench serve --seconds 1 --repair-threads 65
 
 echo "$passed passed, $failed failed"
 ((failed == 0))

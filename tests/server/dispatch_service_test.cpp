@@ -1,5 +1,8 @@
 #include "server/dispatch_service.hpp"
 
+#include <pthread.h>
+#include <sched.h>
+
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 
@@ -322,13 +325,19 @@ INSTANTIATE_TEST_SUITE_P(DispatchService, ConcurrentReports, ::testing::Values(P
                            return p.param == PlannerGraph::hierarchy ? std::string("hierarchy") : std::string("turn_graph");
                          });
 
-// The repair pool changes who repairs, not what: one thread and four give the same routes.
+// The repair pool changes who repairs, not what: one thread, four, and two at real-time priority
+// give the same routes, and the calling thread leaves a batch with its own scheduling.
 TEST(DispatchService, RepairThreadsDoNotChangeTheRepairedRoutes) {
   std::vector<std::vector<std::vector<EdgeId>>> routes;
-  for (int threads : {1, 4}) {
+  for (const auto& [threads, priority] : {std::pair{1, 0}, std::pair{4, 0}, std::pair{2, 1}}) {
     DispatchConfig config;
     config.repair_threads = threads;
+    config.repair_realtime_priority = priority;
     DispatchService service(grid(), config, nullptr, 0.0);
+    EXPECT_FALSE(service.repair_realtime_granted().has_value());
+    int policy_before = -1;
+    sched_param param_before{};
+    ASSERT_EQ(pthread_getschedparam(pthread_self(), &policy_before, &param_before), 0);
     std::vector<MissionId> ids;
     for (int i = 0; i < 6; ++i) ids.push_back(service.create_mission(request("amb-" + std::to_string(i)), 0.0).id);
     std::vector<CongestionUpdate> updates;
@@ -339,6 +348,13 @@ TEST(DispatchService, RepairThreadsDoNotChangeTheRepairedRoutes) {
       updates.push_back(u);
     }
     const CongestionResult r = service.report_congestion(updates, 1.0);
+    int policy_after = -1;
+    sched_param param_after{};
+    ASSERT_EQ(pthread_getschedparam(pthread_self(), &policy_after, &param_after), 0);
+    EXPECT_EQ(policy_after, policy_before);
+    EXPECT_EQ(param_after.sched_priority, param_before.sched_priority);
+    // Granted or not (that is the machine's to say), a configured priority was asked for.
+    EXPECT_EQ(service.repair_realtime_granted().has_value(), priority > 0);
     EXPECT_EQ(r.missions_replanned, ids.size());
     EXPECT_EQ(r.routes_changed, ids.size());  // all six share the congested corner-to-corner route
     EXPECT_GT(r.slowest_replan_s, 0.0);
@@ -355,9 +371,15 @@ TEST(DispatchService, RepairThreadsDoNotChangeTheRepairedRoutes) {
     for (MissionId id : ids) routes.back().push_back(service.mission(id).route.edges);
   }
   EXPECT_EQ(routes[0], routes[1]);
+  EXPECT_EQ(routes[0], routes[2]);
   DispatchConfig bad;
   bad.repair_threads = 0;
   EXPECT_THROW(DispatchService(grid(), bad, nullptr, 0.0), std::invalid_argument);
+  for (int priority : {-1, 100}) {
+    DispatchConfig bad_priority;
+    bad_priority.repair_realtime_priority = priority;
+    EXPECT_THROW(DispatchService(grid(), bad_priority, nullptr, 0.0), std::invalid_argument) << priority;
+  }
 }
 
 // The missions' graph changes how a repair works, not what it finds: a service on the turn graph
