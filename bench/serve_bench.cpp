@@ -340,11 +340,8 @@ json run_serve_bench(const maps::RoadGraph& graph, const ServeBenchConfig& c) {
                    {"seconds", c.seconds}, {"rate_per_s", c.rate_per_s}, {"client_threads", c.client_threads}, {"server_threads", c.server_threads},
                    {"repair_threads", dispatch.repair_threads}, {"repair_priority", c.repair_realtime_priority}};
   // Whether the real-time priority asked for was granted (null: not asked).
-  if (const auto granted = service.repair_realtime_granted()) {
-    out["config"]["repair_priority_granted"] = *granted;
-  } else {
-    out["config"]["repair_priority_granted"] = nullptr;
-  }
+  const auto granted = service.repair_realtime_granted();
+  out["config"]["repair_priority_granted"] = granted ? json(*granted) : json(nullptr);
   // In-process server and load generator: the resident set is both, the mission delta the server's.
   out["memory"] = {{"rss_mb_before_missions", rss_before_missions},
                    {"rss_mb_with_missions", rss_with_missions},
