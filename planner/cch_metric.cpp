@@ -447,8 +447,10 @@ double CchMetric::settle(std::uint32_t arc, bool upward, std::vector<std::uint32
     // The witness rose above another way's bound. Every weight is at most its triangles' sums and
     // its input (a fall is carried up at once, a rise only raises them), so each triangle's sum
     // today is a lower bound of its real cost. The triangles are read once, those below the best
-    // real path so far taken in order of their bounds, each settled; once the next bound is no
-    // lower than the best settled sum, no triangle can beat it. Settling raises weights only, so
+    // real path so far taken in order of their bounds, each settled one side at a time (a side
+    // that lifts the sum to the best so far ends the triangle's turn, and its other side is left
+    // as it is); once the next bound is no lower than the best settled sum, no triangle can beat
+    // it. Settling raises weights only, so
     // the bounds read stay bounds while the sides below them are settled. What loses is the
     // arc's new rival.
     double rest = own.input() ? kInfCost : best.via == own ? me.input : own_s;
@@ -476,7 +478,15 @@ double CchMetric::settle(std::uint32_t arc, bool upward, std::vector<std::uint32
         rest = std::min(rest, bound);
         continue;
       }
-      const double s = settled_sum(c.via);
+      // One side settled may already lift the sum to the best so far: the other side's weight
+      // today is a lower bound of it, so the triangle loses without settling it.
+      const double first = upward ? settle(c.via.to_tail, false, raised) : settle(c.via.to_head, false, raised);
+      const double partial = add_cost(first, upward ? up_[c.via.to_head] : up_[c.via.to_tail]);
+      if (partial >= best.weight) {
+        rest = std::min(rest, partial);
+        continue;
+      }
+      const double s = add_cost(first, upward ? settle(c.via.to_head, true, raised) : settle(c.via.to_tail, true, raised));
       if (s < best.weight) {
         rest = std::min(rest, best.weight);
         best = Derived{s, c.via};
