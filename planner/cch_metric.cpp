@@ -1,6 +1,7 @@
 #include "planner/cch_metric.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cassert>
 #include <cmath>
 #include <limits>
@@ -200,6 +201,14 @@ void CchMetric::for_each_lower_triangle(std::uint32_t arc, bool upward, F&& f) c
   // Both lists ascend by z.
   const auto zx = upward ? lower_out_.of(x) : lower_in_.of(x);
   const auto zy = upward ? lower_in_.of(y) : lower_out_.of(y);
+  // The triangles are gathered a run at a time and their sides' weights fetched, then summed: the
+  // sides lie scattered over the metric, and their misses overlap this way (as in propagate()).
+  std::array<Witness, 16> run;
+  std::size_t gathered = 0;
+  const auto sum_run = [&] {
+    for (std::size_t r = 0; r < gathered; ++r) f(side_sum(run[r], upward), run[r]);
+    gathered = 0;
+  };
   auto i = zx.begin();
   auto j = zy.begin();
   while (i != zx.end() && j != zy.end() && j->tail < x) {
@@ -209,11 +218,15 @@ void CchMetric::for_each_lower_triangle(std::uint32_t arc, bool upward, F&& f) c
       j = gallop_to(j, zy.end(), i->tail, tail_of);
     } else {
       const Witness z{i->arc, j->arc};
-      f(side_sum(z, upward), z);
+      __builtin_prefetch(upward ? &down_[z.to_tail] : &down_[z.to_head]);
+      __builtin_prefetch(upward ? &up_[z.to_head] : &up_[z.to_tail]);
+      run[gathered++] = z;
+      if (gathered == run.size()) sum_run();
       ++i;
       ++j;
     }
   }
+  sum_run();
 }
 
 CchMetric::Derived CchMetric::derive(std::uint32_t arc, bool upward) const {
@@ -233,6 +246,12 @@ void CchMetric::queue(std::uint32_t arc, std::uint8_t derive) {
   pending_.push_back({up_[arc], down_[arc], derive});
   slot_[arc] = static_cast<std::uint32_t>(pending_.size());
   queue_.push(arc);
+}
+
+void CchMetric::prefetch_offer(std::uint32_t arc, bool upward) const {
+  __builtin_prefetch(upward ? &up_[arc] : &down_[arc], 1);
+  __builtin_prefetch(upward ? &via_up_[arc] : &via_down_[arc], 1);
+  if (options_.lazy_rises) __builtin_prefetch(upward ? &rival_up_[arc] : &rival_down_[arc], 1);
 }
 
 void CchMetric::offer(std::uint32_t arc, bool upward, double old_s, double new_s, Witness via, std::uint32_t middle) {
@@ -382,8 +401,13 @@ CustomizationStats CchMetric::propagate(std::vector<std::uint32_t>& changed) {
     };
     // The triangles riding on one direction of {x, y} that moved: y→x→z (on y→x, through open
     // x→z) `from_y`, z→x→y (on x→y, through open z→x) otherwise.
+    // In two passes: the offers read and write arcs scattered over the metric (their weight,
+    // witness and rival, three cache misses each), so the arcs are gathered and their lines
+    // fetched first, and the misses overlap instead of coming one after another. The offers
+    // change only arcs above x, none of x's own, so the sides read in the first pass still hold.
     const auto offer_triangles = [&](bool from_y, double old_s, double new_s) {
       std::size_t k = 0, m = 0;
+      offers_.clear();
       for (const CchDownArc& e : from_y ? upper_out_.of(x) : upper_in_.of(x)) {
         const std::uint32_t z = e.tail, xz = e.arc;
         if (z == y) continue;
@@ -394,10 +418,13 @@ CustomizationStats CchMetric::propagate(std::vector<std::uint32_t>& changed) {
         const double side = from_y ? (queued != nullptr ? queued->old_up : up_[xz])
                                    : (queued != nullptr ? queued->old_down : down_[xz]);
         if (side >= kInfCost) continue;
+        const std::uint32_t target = between(z, k, m);
+        const bool upward = from_y == (z > y);
+        prefetch_offer(target, upward);
         // The arc {y, z}'s witness is x: its sides are {x, y} (this arc) and {x, z}.
-        const Witness via = z > y ? Witness{arc, xz} : Witness{xz, arc};
-        offer(between(z, k, m), from_y == (z > y), add_cost(old_s, side), add_cost(new_s, side), via, x);
+        offers_.push_back({target, upward, side, z > y ? Witness{arc, xz} : Witness{xz, arc}});
       }
+      for (const Offer& o : offers_) offer(o.arc, o.upward, add_cost(old_s, o.side), add_cost(new_s, o.side), o.via, x);
     };
     if (down_moved) offer_triangles(true, p.old_down, down_[arc]);
     if (up_moved) offer_triangles(false, p.old_up, up_[arc]);
@@ -431,6 +458,12 @@ double CchMetric::settle(std::uint32_t arc, bool upward, std::vector<std::uint32
   // the weight (the common case) the lower bound is attained, so exact.
   LazyWay& me = way(arc, upward);
   const Witness own = witness(arc, upward);
+  // The walk goes down one side of the witness, then the other: both sides' lines are asked for
+  // now, so that the second's miss overlaps the first side's walk.
+  if (!own.input()) {
+    __builtin_prefetch(upward ? &lazy_down_[own.to_tail] : &lazy_down_[own.to_head]);
+    __builtin_prefetch(upward ? &lazy_up_[own.to_head] : &lazy_up_[own.to_tail]);
+  }
   const auto settled_sum = [&](Witness z) {
     // x→z→y upward, y→z→x downward, z below both (as unpack follows them).
     return upward ? add_cost(settle(z.to_tail, false, raised), settle(z.to_head, true, raised))

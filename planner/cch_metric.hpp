@@ -134,6 +134,16 @@ class CchMetric {
   void for_each_lower_triangle(std::uint32_t arc, bool upward, F&& f) const;
   // settle()'s triangles still to look at, one run per call on the recursion's stack.
   std::vector<Derived> candidates_;
+  // propagate()'s offers of one moved arc, gathered before they are made (prefetch_offer).
+  struct Offer {
+    std::uint32_t arc;
+    bool upward;
+    double side;  // the triangle's other side {x, z}
+    Witness via;
+  };
+  std::vector<Offer> offers_;
+  // Asks for the cache lines offer() reads of arc `arc` in that direction.
+  void prefetch_offer(std::uint32_t arc, bool upward) const;
   // The sum over a triangle's sides today, the way asked: x→z→y upward, y→z→x downward.
   [[nodiscard]] double side_sum(Witness w, bool upward) const {
     return upward ? add_cost(down_[w.to_tail], up_[w.to_head]) : add_cost(down_[w.to_head], up_[w.to_tail]);
