@@ -37,9 +37,8 @@ CchMetric::CchMetric(const CchTopology& topology, const TravelCost& cost, CchMet
   if (options_.lazy_rises) {
     // Every weight of a full customization is exact: found so in batch 1, before any change (and
     // no subtree has seen a rise since).
-    changed_below_.assign(topology.vertex_count(), batch_);
-    parent_.resize(topology.vertex_count());
-    for (std::uint32_t r = 0; r < topology.vertex_count(); ++r) parent_[r] = topology.parent(r);
+    marks_.resize(topology.vertex_count());
+    for (std::uint32_t r = 0; r < topology.vertex_count(); ++r) marks_[r] = {batch_, topology.parent(r)};
     for (auto* ways : {&lazy_up_, &lazy_down_}) {
       for (LazyWay& w : *ways) w.exact = batch_;
     }
@@ -50,8 +49,8 @@ void CchMetric::mark_changed(std::uint32_t arc) {
   if (!options_.lazy_rises || arc == kNoCchArc) return;
   // The arc's lower end and its ancestors: every subtree that holds this input. A vertex already
   // marked in this batch has its ancestors marked too.
-  for (std::uint32_t r = topology_->tail(arc); r != kNoCchArc && changed_below_[r] != batch_; r = parent_[r]) {
-    changed_below_[r] = batch_;
+  for (std::uint32_t r = topology_->tail(arc); r != kNoCchArc && marks_[r].changed_below != batch_; r = marks_[r].parent) {
+    marks_[r].changed_below = batch_;
   }
 }
 
@@ -637,7 +636,7 @@ std::string CchMetric::invariant_violation() const {
 std::size_t CchMetric::memory_bytes() const {
   return (up_.size() + down_.size()) * sizeof(double) + (via_up_.size() + via_down_.size()) * sizeof(Witness) +
          (lazy_up_.size() + lazy_down_.size()) * sizeof(LazyWay) + (rival_up_.size() + rival_down_.size()) * sizeof(float) +
-         (slot_.size() + changed_below_.size() + parent_.size()) * sizeof(std::uint32_t) +
+         slot_.size() * sizeof(std::uint32_t) + marks_.size() * sizeof(TreeMark) +
          queue_.memory_bytes() +
          pending_.capacity() * sizeof(Pending) +
          [&] {

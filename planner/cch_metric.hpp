@@ -209,8 +209,13 @@ class CchMetric {
   // p50 and p99 by 5–10 %; reading the mark at the witness's middle rather than at the arc's
   // lower end (a subtree that holds the arc's every triangle) left 35 % fewer arcs to walk.
   std::uint32_t batch_ = 1;
-  HugePageVector<std::uint32_t> changed_below_;           // by rank: the batch of the last input rise in its subtree
-  HugePageVector<std::uint32_t> parent_;                  // by rank: the topology's parent(), in one array for the climb
+  // By rank: the batch of the last input rise in its subtree, and the topology's parent(), side by
+  // side: the climb reads both at each step, one cache miss instead of two.
+  struct TreeMark {
+    std::uint32_t changed_below;
+    std::uint32_t parent;
+  };
+  HugePageVector<TreeMark> marks_;
   // Lazy rises: what settle() reads of one arc direction to decide whether to look further, side
   // by side: the walk visits arcs scattered over a metric far larger than the cache (over 100 MB
   // on Porto), and an arc known exact then costs one line. (Weights, witnesses and rivals stay in
@@ -247,7 +252,7 @@ class CchMetric {
   [[nodiscard]] bool known_exact(std::uint32_t arc, bool upward) const {
     const LazyWay& w = way(arc, upward);
     if (w.exact == 0) return false;
-    return w.middle == kNoCchArc || w.exact >= changed_below_[w.middle];
+    return w.middle == kNoCchArc || w.exact >= marks_[w.middle].changed_below;
   }
   const void* settler_ = nullptr;
 };
