@@ -105,8 +105,8 @@ void register_bench_command(CLI::App& app) {
   serve->add_option("--client-threads", s->second.client_threads, "load generator threads")->capture_default_str();
   serve->add_option("--server-threads", s->second.server_threads, "server I/O threads")->capture_default_str();
   serve->add_option("--repair-threads", s->second.repair_threads,
-                    "threads repairing plans after a congestion batch, its request's I/O thread included (0 = as many as "
-                    "--server-threads)")
+                    "threads repairing plans after a congestion batch, its request's I/O thread included (0 = as serve "
+                    "chooses: half of --server-threads, at least 1)")
       ->capture_default_str();
   serve->add_option("--repair-priority", s->second.repair_realtime_priority,
                     "0, or the real-time (SCHED_FIFO) priority of repairs, as serve's --repair-priority")

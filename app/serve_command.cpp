@@ -29,6 +29,7 @@ struct ServeOptions {
   std::string listen = "127.0.0.1:8080";
   std::string config;
   int threads = 2;
+  int repair_threads = 0;  // 0: server::default_repair_threads(threads)
   int repair_priority = 0;
   bool demo = false;
   server::PlannerGraph planner_graph = server::PlannerGraph::automatic;
@@ -91,7 +92,7 @@ void run_serve(const ServeOptions& o) {
   };
   const std::filesystem::path map_file = o.map.map_file.empty() ? CORRIDOR_DEFAULT_MAP : o.map.map_file;
   server::DispatchConfig dispatch;
-  dispatch.repair_threads = o.threads;  // as many as serve requests
+  dispatch.repair_threads = o.repair_threads > 0 ? o.repair_threads : server::default_repair_threads(o.threads);
   dispatch.repair_realtime_priority = o.repair_priority;
   dispatch.planner_graph = o.planner_graph;
   server::DispatchService service(graph, maps::signal_plans_for(map_file, graph), dispatch, &store, now());
@@ -168,7 +169,12 @@ void register_serve_command(CLI::App& app) {
   cmd->add_option("--db", o->db, "SQLite database (created if missing)")->capture_default_str();
   cmd->add_option("--listen", o->listen, "HOST:PORT to listen on (port 0 picks a free one)")->capture_default_str();
   cmd->add_option("--config", o->config, "JSON config: tokens with roles, limits");
-  cmd->add_option("--threads", o->threads, "I/O threads; as many repair plans in parallel after a congestion change")->capture_default_str();
+  cmd->add_option("--threads", o->threads, "I/O threads")->capture_default_str();
+  cmd->add_option("--repair-threads", o->repair_threads,
+                  "threads repairing plans after a congestion change, its request's I/O thread included (0 = half of "
+                  "--threads, at least 1: docs/routing.md)")
+      ->check(CLI::Range(0, 64))
+      ->capture_default_str();
   cmd->add_option("--repair-priority", o->repair_priority,
                   "0, or the real-time (SCHED_FIFO) priority repairs after a congestion change run at, so other "
                   "work cannot preempt them (needs root or CAP_SYS_NICE; docs/routing.md)")

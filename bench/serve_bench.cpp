@@ -208,7 +208,7 @@ json run_serve_bench(const maps::RoadGraph& graph, const ServeBenchConfig& c) {
   server::Store store(db);
   const auto now = [] { return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count(); };
   server::DispatchConfig dispatch;
-  dispatch.repair_threads = c.repair_threads > 0 ? c.repair_threads : c.server_threads;
+  dispatch.repair_threads = c.repair_threads > 0 ? c.repair_threads : server::default_repair_threads(c.server_threads);
   dispatch.planner_graph = c.planner_graph;
   dispatch.repair_realtime_priority = c.repair_realtime_priority;
   server::DispatchService service(graph, dispatch, &store, now());

@@ -22,7 +22,7 @@ struct ServeBenchConfig {
   int client_threads = 1;
   int server_threads = 2;
   // Threads that repair plans after a congestion batch, the request's own I/O thread included;
-  // 0 = as many as server_threads.
+  // 0 = as serve chooses (server::default_repair_threads: half of server_threads, at least 1).
   int repair_threads = 0;
   int repair_realtime_priority = 0;  // DispatchConfig's
   server::PlannerGraph planner_graph = server::PlannerGraph::automatic;

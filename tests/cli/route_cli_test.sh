@@ -198,7 +198,8 @@ shares = [b["share"] for b in r["share_within"]]
 assert shares == sorted(shares) and shares[-1] == 1.0, shares
 assert r["p99_at_most_ms"] is not None and r["p99_at_most_ms"] <= 1000, r
 cfg = j["config"]
-assert cfg["repair_threads"] == cfg["server_threads"] == 2 and cfg["repair_priority"] == 0, cfg
+# By default half the I/O threads repair (server::default_repair_threads), at least one.
+assert cfg["server_threads"] == 2 and cfg["repair_threads"] == 1 and cfg["repair_priority"] == 0, cfg
 assert cfg["repair_priority_granted"] is None, cfg  # nothing asked for
 PY
 then pass; else fail "bench serve output: $(head -c 400 "$work/serve.json")"; fi
@@ -219,6 +220,7 @@ then pass; else fail "bench serve --repair-priority output: $(head -c 400 "$work
 expect_error "not in range" "$corridor" bench serve --seconds 1 --repair-priority 100
 expect_error "not in range" "$corridor" serve --repair-priority -1
 expect_error "repair threads 0..64" "$corridor" bench serve --seconds 1 --repair-threads 65
+expect_error "not in range" "$corridor" serve --repair-threads 65
 
 echo "$passed passed, $failed failed"
 ((failed == 0))

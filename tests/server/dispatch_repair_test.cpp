@@ -185,6 +185,21 @@ TEST(DispatchService, RepairThreadsDoNotChangeTheRepairedRoutes) {
   }
 }
 
+// Half the I/O threads repair by default, at least one, and the service accepts every count the
+// rule gives.
+TEST(DispatchService, DefaultRepairThreadsAreHalfTheIoThreads) {
+  EXPECT_EQ(default_repair_threads(1), 1);
+  EXPECT_EQ(default_repair_threads(2), 1);
+  EXPECT_EQ(default_repair_threads(3), 1);
+  EXPECT_EQ(default_repair_threads(4), 2);
+  EXPECT_EQ(default_repair_threads(64), 32);
+  for (int io : {1, 2, 64}) {
+    DispatchConfig config;
+    config.repair_threads = default_repair_threads(io);
+    EXPECT_NO_THROW(DispatchService(grid(), config, nullptr, 0.0)) << io;
+  }
+}
+
 // The missions' graph changes how a repair works, not what it finds: a service on the turn graph
 // and one on the shared hierarchy, given the same missions (two profiles at two top speeds: four
 // cost models, of which the hierarchy holds at most three, so the fourth plans on the turn graph
