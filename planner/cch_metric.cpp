@@ -482,9 +482,8 @@ double CchMetric::settle(std::uint32_t arc, bool upward, std::vector<std::uint32
     // real path so far taken in order of their bounds, each settled one side at a time (a side
     // that lifts the sum to the best so far ends the triangle's turn, and its other side is left
     // as it is); once the next bound is no lower than the best settled sum, no triangle can beat
-    // it. Settling raises weights only, so
-    // the bounds read stay bounds while the sides below them are settled. What loses is the
-    // arc's new rival.
+    // it. Settling raises weights only, so the bounds read stay bounds while the sides below them
+    // are settled. What loses is the arc's new rival.
     double rest = own.input() ? kInfCost : best.via == own ? me.input : own_s;
     const std::size_t base = candidates_.size();
     for_each_lower_triangle(arc, upward, [&](double s, Witness z) {
