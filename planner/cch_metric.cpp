@@ -1,7 +1,6 @@
 #include "planner/cch_metric.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cassert>
 #include <cmath>
 #include <limits>
@@ -200,14 +199,6 @@ void CchMetric::for_each_lower_triangle(std::uint32_t arc, bool upward, F&& f) c
   // Both lists ascend by z.
   const auto zx = upward ? lower_out_.of(x) : lower_in_.of(x);
   const auto zy = upward ? lower_in_.of(y) : lower_out_.of(y);
-  // The triangles are gathered a run at a time and their sides' weights fetched, then summed: the
-  // sides lie scattered over the metric, and their misses overlap this way (as in propagate()).
-  std::array<Witness, 16> run;
-  std::size_t gathered = 0;
-  const auto sum_run = [&] {
-    for (std::size_t r = 0; r < gathered; ++r) f(side_sum(run[r], upward), run[r]);
-    gathered = 0;
-  };
   auto i = zx.begin();
   auto j = zy.begin();
   while (i != zx.end() && j != zy.end() && j->tail < x) {
@@ -217,15 +208,11 @@ void CchMetric::for_each_lower_triangle(std::uint32_t arc, bool upward, F&& f) c
       j = gallop_to(j, zy.end(), i->tail, tail_of);
     } else {
       const Witness z{i->arc, j->arc};
-      __builtin_prefetch(upward ? &down_[z.to_tail] : &down_[z.to_head]);
-      __builtin_prefetch(upward ? &up_[z.to_head] : &up_[z.to_tail]);
-      run[gathered++] = z;
-      if (gathered == run.size()) sum_run();
+      f(side_sum(z, upward), z);
       ++i;
       ++j;
     }
   }
-  sum_run();
 }
 
 CchMetric::Derived CchMetric::derive(std::uint32_t arc, bool upward) const {
@@ -457,12 +444,6 @@ double CchMetric::settle(std::uint32_t arc, bool upward, std::vector<std::uint32
   // the weight (the common case) the lower bound is attained, so exact.
   LazyWay& me = way(arc, upward);
   const Witness own = witness(arc, upward);
-  // The walk goes down one side of the witness, then the other: both sides' lines are asked for
-  // now, so that the second's miss overlaps the first side's walk.
-  if (!own.input()) {
-    __builtin_prefetch(upward ? &lazy_down_[own.to_tail] : &lazy_down_[own.to_head]);
-    __builtin_prefetch(upward ? &lazy_up_[own.to_head] : &lazy_up_[own.to_tail]);
-  }
   const auto settled_sum = [&](Witness z) {
     // x→z→y upward, y→z→x downward, z below both (as unpack follows them).
     return upward ? add_cost(settle(z.to_tail, false, raised), settle(z.to_head, true, raised))
