@@ -63,39 +63,139 @@ void CchSearchSpace::build_down(std::vector<std::uint32_t> members) {
   for (std::uint32_t x : down_set_) {
     for (const CchDownArc& a : metric_->upper_in(x)) down_arcs_[fill[slots[next++]]++] = {x, a.arc};
   }
+  down_range_.resize(down_set_.size());
+  for (std::size_t i = 0; i < down_set_.size(); ++i) down_range_[i] = {topology_->first_up(down_set_[i]), topology_->first_up(down_set_[i] + 1)};
 }
 
 void CchSearchSpace::build_up(std::vector<std::uint32_t> members) {
   up_set_ = std::move(members);
   // Filed under the higher end, as the sweep reads them; each list ascends by lower end, and so
   // by arc id (ids ascend by lower end).
-  std::vector<std::uint32_t> heads;
+  heads_.clear();
   up_first_.assign(up_set_.size() + 1, 0);
   for (std::size_t i = 0; i < up_set_.size(); ++i) {
     auto at = up_set_.begin() + static_cast<std::ptrdiff_t>(i);
     for (const CchDownArc& a : metric_->upper_out(up_set_[i])) {
       at = gallop_to(at, up_set_.end(), a.tail, [](std::uint32_t r) { return r; });
-      heads.push_back(static_cast<std::uint32_t>(at - up_set_.begin()));
-      ++up_first_[heads.back() + 1];
+      heads_.push_back(static_cast<std::uint32_t>(at - up_set_.begin()));
+      ++up_first_[heads_.back() + 1];
     }
   }
   for (std::size_t i = 1; i < up_first_.size(); ++i) up_first_[i] += up_first_[i - 1];
   up_arcs_.resize(up_first_.back());
   up_weight_s_.resize(up_first_.back());
-  std::vector<std::uint32_t> fill(up_first_.begin(), up_first_.end() - 1);
-  up_slot_.resize(heads.size());
+  std::vector<std::uint32_t>& fill = spare_.fill;
+  fill.assign(up_first_.begin(), up_first_.end() - 1);
+  up_slot_.resize(heads_.size());
   up_out_first_.resize(up_set_.size() + 1);
   std::uint32_t next = 0;
   for (std::uint32_t i = 0; i < up_set_.size(); ++i) {
     up_out_first_[i] = next;
     for (const CchDownArc& a : metric_->upper_out(up_set_[i])) {
-      const std::uint32_t k = fill[heads[next]]++;
+      const std::uint32_t k = fill[heads_[next]]++;
       up_slot_[next++] = k;
       up_arcs_[k] = {i, a.arc};
       up_weight_s_[k] = metric_->up_s(a.arc);
     }
   }
   up_out_first_[up_set_.size()] = next;
+  up_range_.resize(up_set_.size());
+  up_parent_.resize(up_set_.size());
+  describe_up_members(0, up_set_.size());
+  find_meetings();
+}
+
+void CchSearchSpace::rebuild_up(std::vector<std::uint32_t> members, std::size_t shared) {
+  if (shared == 0) {
+    build_up(std::move(members));
+    return;
+  }
+  // The places below the shared top: [0, old_low) now, [0, low) in the new half. A shared member
+  // at new place h was at h - low + old_low.
+  const std::size_t n = members.size();
+  const auto low = static_cast<std::uint32_t>(n - shared);
+  const auto old_low = static_cast<std::uint32_t>(up_set_.size() - shared);
+  const auto old_place = [&](std::size_t h) { return h - low + old_low; };
+  // Where a shared head's kept arcs begin in its old list: the arcs from shared tails, which end
+  // the list (it ascends by tail).
+  const auto kept_from = [&](std::size_t h) {
+    const auto b = up_arcs_.begin() + up_first_[old_place(h)], e = up_arcs_.begin() + up_first_[old_place(h) + 1];
+    return static_cast<std::uint32_t>(std::partition_point(b, e, [&](const UpArc& a) { return a.tail_place < old_low; }) - up_arcs_.begin());
+  };
+  UpArrays& nx = spare_;
+  nx.first.assign(n + 1, 0);
+  heads_.clear();
+  // The new members' arcs, from the metric; each ends at a member above its tail, new or shared.
+  for (std::size_t i = 0; i < low; ++i) {
+    auto at = members.begin() + static_cast<std::ptrdiff_t>(i);
+    for (const CchDownArc& a : metric_->upper_out(members[i])) {
+      at = gallop_to(at, members.end(), a.tail, [](std::uint32_t r) { return r; });
+      heads_.push_back(static_cast<std::uint32_t>(at - members.begin()));
+      ++nx.first[heads_.back() + 1];
+    }
+  }
+  for (std::size_t h = low; h < n; ++h) nx.first[h + 1] += up_first_[old_place(h) + 1] - kept_from(h);
+  for (std::size_t i = 1; i <= n; ++i) nx.first[i] += nx.first[i - 1];
+  nx.arcs.resize(nx.first.back());
+  nx.weight_s.resize(nx.first.back());
+  nx.fill.assign(nx.first.begin(), nx.first.end() - 1);
+  nx.slot.resize(heads_.size() + (up_slot_.size() - up_out_first_[old_low]));
+  nx.out_first.resize(n + 1);
+  std::uint32_t next = 0;
+  for (std::uint32_t i = 0; i < low; ++i) {
+    nx.out_first[i] = next;
+    for (const CchDownArc& a : metric_->upper_out(members[i])) {
+      const std::uint32_t k = nx.fill[heads_[next]]++;
+      nx.slot[next++] = k;
+      nx.arcs[k] = {i, a.arc};
+      nx.weight_s[k] = metric_->up_s(a.arc);
+    }
+  }
+  // The shared arcs follow the new ones into each shared head, with their weights as last
+  // reported (arcs_changed keeps them so), tails moved to their new places.
+  moved_slot_.resize(up_arcs_.size());
+  for (std::size_t h = low; h < n; ++h) {
+    for (std::uint32_t k = kept_from(h), e = up_first_[old_place(h) + 1]; k < e; ++k) {
+      const std::uint32_t to = nx.fill[h]++;
+      nx.arcs[to] = {up_arcs_[k].tail_place - old_low + low, up_arcs_[k].arc};
+      nx.weight_s[to] = up_weight_s_[k];
+      moved_slot_[k] = to;
+    }
+  }
+  nx.range.resize(n);
+  nx.parent.resize(n);
+  for (std::size_t t = low; t < n; ++t) {
+    const std::size_t o = old_place(t);
+    nx.out_first[t] = next;
+    for (std::uint32_t j = up_out_first_[o]; j < up_out_first_[o + 1]; ++j) nx.slot[next++] = moved_slot_[up_slot_[j]];
+    nx.range[t] = up_range_[o];
+    nx.parent[t] = up_parent_[o] == kNoCchArc ? kNoCchArc : up_parent_[o] - old_low + low;
+  }
+  nx.out_first[n] = next;
+  up_set_ = std::move(members);
+  up_first_.swap(nx.first);
+  up_arcs_.swap(nx.arcs);
+  up_weight_s_.swap(nx.weight_s);
+  up_slot_.swap(nx.slot);
+  up_out_first_.swap(nx.out_first);
+  up_range_.swap(nx.range);
+  up_parent_.swap(nx.parent);
+  describe_up_members(0, low);
+  find_meetings();
+}
+
+void CchSearchSpace::describe_up_members(std::size_t from, std::size_t to) {
+  for (std::size_t i = from; i < to; ++i) {
+    const std::uint32_t x = up_set_[i];
+    up_range_[i] = {topology_->first_up(x), topology_->first_up(x + 1)};
+    const std::uint32_t p = topology_->parent(x);
+    up_parent_[i] = p == kNoCchArc ? kNoCchArc
+                                   : static_cast<std::uint32_t>(std::lower_bound(up_set_.begin() + static_cast<std::ptrdiff_t>(i) + 1, up_set_.end(), p) -
+                                                                up_set_.begin());
+  }
+}
+
+void CchSearchSpace::find_meetings() {
   meetings_.clear();
   auto d = down_set_.begin();
   for (std::uint32_t i = 0; i < up_set_.size(); ++i) {
@@ -106,6 +206,25 @@ void CchSearchSpace::build_up(std::vector<std::uint32_t> members) {
   up_cost_.assign(up_set_.size(), kInfCost);
   up_step_.assign(up_set_.size(), Step{});
   seeds_.clear();
+}
+
+std::size_t CchSearchSpace::ancestors_of_starts(std::span<const std::uint32_t> from, std::vector<std::uint32_t>& out) const {
+  out.clear();
+  for (const std::uint32_t r : from) {
+    for (std::uint32_t x = r; x != kNoCchArc; x = topology_->parent(x)) {
+      const auto it = std::lower_bound(up_set_.begin(), up_set_.end(), x);
+      if (it != up_set_.end() && *it == x) {
+        for (auto p = static_cast<std::uint32_t>(it - up_set_.begin()); p != kNoCchArc; p = up_parent_[p]) out.push_back(up_set_[p]);
+        break;
+      }
+      out.push_back(x);
+    }
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  std::size_t shared = 0;
+  while (shared < out.size() && shared < up_set_.size() && out[out.size() - 1 - shared] == up_set_[up_set_.size() - 1 - shared]) ++shared;
+  return shared;
 }
 
 bool CchSearchSpace::seed() {
@@ -166,8 +285,8 @@ double CchSearchSpace::move_starts(std::vector<EdgePoint> starts) {
   if (from != start_ranks_) {
     start_ranks_ = from;
     std::vector<std::uint32_t> members;
-    topology_->ancestors(from, members);
-    if (members != up_set_) build_up(std::move(members));
+    const std::size_t shared = ancestors_of_starts(from, members);
+    if (shared != up_set_.size() || members.size() != shared) rebuild_up(std::move(members), shared);
   }
   refresh_start();
   return 0.0;
@@ -208,22 +327,30 @@ void CchSearchSpace::scan_batch(std::span<const std::uint32_t> arcs, std::vector
     }
     return;
   }
-  // Arc ids are grouped by their lower end: member x's arcs are [first_up(x), first_up(x + 1)).
-  // Each half's members are ascending, so one forward pass over the batch serves each half.
-  const auto scan = [&](const std::vector<std::uint32_t>& members, auto&& f) {
+  // Arc ids are grouped by their lower end: member x's arcs are [first_up(x), first_up(x + 1)),
+  // kept beside each half's members (ascending, so their ranges ascend too). One merge of the
+  // batch with each half's ranges, galloping on whichever side is behind: a report of a few
+  // dozen raised arcs skips most members, a city-wide batch most arcs.
+  const auto scan = [&](const std::vector<ArcRange>& ranges, auto&& f) {
     auto it = arcs.begin();
-    for (std::uint32_t place = 0; place < members.size(); ++place) {
-      const std::uint32_t x = members[place];
-      it = std::lower_bound(it, arcs.end(), topology_->first_up(x));
-      if (it == arcs.end()) return;
-      std::size_t j = 0;  // the member's own cursor, for the upward half's slots
-      for (const std::uint32_t hi = topology_->first_up(x + 1); it != arcs.end() && *it < hi; ++it) f(*it, place, j);
+    auto r = ranges.begin();
+    std::size_t j = 0;  // the member's own cursor, for the upward half's slots
+    while (it != arcs.end() && r != ranges.end()) {
+      if (*it < r->first) {
+        it = gallop_to(it, arcs.end(), r->first, [](std::uint32_t a) { return a; });
+      } else if (*it >= r->end) {
+        r = gallop_to(r, ranges.end(), *it + 1, [](const ArcRange& x) { return x.end; });
+        j = 0;
+      } else {
+        f(*it, static_cast<std::uint32_t>(r - ranges.begin()), j);
+        ++it;
+      }
     }
   };
-  scan(down_set_, [&](std::uint32_t arc, std::uint32_t, std::size_t&) {
+  scan(down_range_, [&](std::uint32_t arc, std::uint32_t, std::size_t&) {
     if (metric_->open(arc, false)) out.push_back(Vertex{topology_->head(arc)});
   });
-  scan(up_set_, [&](std::uint32_t arc, std::uint32_t place, std::size_t& j) {
+  scan(up_range_, [&](std::uint32_t arc, std::uint32_t place, std::size_t& j) {
     if (metric_->open(arc, true)) on_up_arc(arc, place, slot_of(place, arc, j));
   });
 }
@@ -292,12 +419,12 @@ Route CchSearchSpace::route_along(const std::vector<Via>& vias) const {
 }
 
 std::size_t CchSearchSpace::heap_bytes() const {
-  return flat_.heap_bytes() + (start_ranks_.capacity() + up_set_.capacity() + up_first_.capacity() + up_slot_.capacity() + up_out_first_.capacity() +
-                              down_set_.capacity() + down_first_.capacity()) *
-                             sizeof(std::uint32_t) +
-         up_arcs_.capacity() * sizeof(UpArc) + down_arcs_.capacity() * sizeof(CchDownArc) + targets_.capacity() * sizeof(Target) +
-         meetings_.capacity() * sizeof(Meeting) + seeds_.capacity() * sizeof(Seed) +
-         (up_weight_s_.capacity() + up_cost_.capacity()) * sizeof(double) + up_step_.capacity() * sizeof(Step);
+  const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+  return flat_.heap_bytes() + bytes(start_ranks_) + bytes(up_set_) + bytes(up_first_) + bytes(up_slot_) + bytes(up_out_first_) +
+         bytes(down_set_) + bytes(down_first_) + bytes(up_arcs_) + bytes(down_arcs_) + bytes(targets_) + bytes(meetings_) +
+         bytes(seeds_) + bytes(up_weight_s_) + bytes(up_cost_) + bytes(up_step_) + bytes(down_range_) + bytes(up_range_) +
+         bytes(up_parent_) + bytes(spare_.first) + bytes(spare_.slot) + bytes(spare_.out_first) + bytes(spare_.parent) +
+         bytes(spare_.fill) + bytes(spare_.arcs) + bytes(spare_.weight_s) + bytes(spare_.range) + bytes(moved_slot_) + bytes(heads_);
 }
 
 }  // namespace corridor::planner

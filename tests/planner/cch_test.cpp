@@ -330,6 +330,18 @@ TEST(CchSearchSpace, StartArcsAreTheCheapestUpwardPathsWhileCostsChangeAndTheVeh
       space.for_each_successor(space.start(), [&](Vertex v, double c, const CchVia&) { kept.emplace_back(v, c); });
       fresh.for_each_successor(fresh.start(), [&](Vertex v, double c, const CchVia&) { built.emplace_back(v, c); });
       ASSERT_EQ(kept, built) << "seed " << seed << " step " << step;
+      // A half carried over from the last start (rebuild_up) finds a batch's vertices as one built
+      // afresh does: a sparse batch, as settling reports, and a dense one, as a city's congestion.
+      for (const std::uint32_t every : {40u, 3u}) {
+        std::vector<std::uint32_t> batch;
+        for (std::uint32_t arc = 0; arc < t.arc_count(); ++arc) {
+          if (rng() % every == 0) batch.push_back(arc);
+        }
+        std::vector<Vertex> kept_on, built_on;
+        space.vertices_on_arcs(batch, kept_on);
+        fresh.vertices_on_arcs(batch, built_on);
+        ASSERT_EQ(kept_on, built_on) << "seed " << seed << " step " << step << " every " << every;
+      }
       // The oracle: every upward arc relaxed until nothing moves, from the start vertices.
       std::vector<double> up(t.vertex_count(), kInfCost);
       for (const EdgePoint& s : space.starts()) {
@@ -392,9 +404,18 @@ TEST(CchSearchSpace, StartArcsAreTheCheapestUpwardPathsWhileCostsChangeAndTheVeh
         space.refresh_start();
         check(step);
       }
-      // Along the same edges most of the time, now and then somewhere else.
+      // Along the same edges most of the time, or on to the next edge (a start vertex of the same
+      // ancestors but the lowest few), now and then somewhere else.
       for (EdgePoint& s : starts) {
-        s = unit(rng) < 0.7 ? EdgePoint{s.edge, std::min(g.length_m(s.edge), s.offset_m + unit(rng) * 20.0)} : testing::random_point(g, rng);
+        const double draw = unit(rng);
+        const auto next = g.out_edges(g.head(s.edge));
+        if (draw < 0.5) {
+          s = EdgePoint{s.edge, std::min(g.length_m(s.edge), s.offset_m + unit(rng) * 20.0)};
+        } else if (draw < 0.8 && !next.empty()) {
+          s = EdgePoint{EdgeId{static_cast<std::uint32_t>((*next.begin()).index() + rng() % next.size())}, 0.0};
+        } else {
+          s = testing::random_point(g, rng);
+        }
       }
       space.move_starts(starts);
       check(step);
