@@ -37,7 +37,7 @@ CchSearchSpace::CchSearchSpace(const CchMetric& metric, std::vector<EdgePoint> s
   start_ranks_ = from;
   members.clear();
   topology_->ancestors(from, members);
-  build_up(std::move(members));
+  build_up(std::move(members), 0);
   (void)seed();
   sweep(0);
 }
@@ -67,51 +67,10 @@ void CchSearchSpace::build_down(std::vector<std::uint32_t> members) {
   for (std::size_t i = 0; i < down_set_.size(); ++i) down_range_[i] = {topology_->first_up(down_set_[i]), topology_->first_up(down_set_[i] + 1)};
 }
 
-void CchSearchSpace::build_up(std::vector<std::uint32_t> members) {
-  up_set_ = std::move(members);
-  // Filed under the higher end, as the sweep reads them; each list ascends by lower end, and so
-  // by arc id (ids ascend by lower end).
-  heads_.clear();
-  up_first_.assign(up_set_.size() + 1, 0);
-  for (std::size_t i = 0; i < up_set_.size(); ++i) {
-    auto at = up_set_.begin() + static_cast<std::ptrdiff_t>(i);
-    for (const CchDownArc& a : metric_->upper_out(up_set_[i])) {
-      at = gallop_to(at, up_set_.end(), a.tail, [](std::uint32_t r) { return r; });
-      heads_.push_back(static_cast<std::uint32_t>(at - up_set_.begin()));
-      ++up_first_[heads_.back() + 1];
-    }
-  }
-  for (std::size_t i = 1; i < up_first_.size(); ++i) up_first_[i] += up_first_[i - 1];
-  up_arcs_.resize(up_first_.back());
-  up_weight_s_.resize(up_first_.back());
-  std::vector<std::uint32_t>& fill = spare_.fill;
-  fill.assign(up_first_.begin(), up_first_.end() - 1);
-  up_slot_.resize(heads_.size());
-  up_out_first_.resize(up_set_.size() + 1);
-  std::uint32_t next = 0;
-  for (std::uint32_t i = 0; i < up_set_.size(); ++i) {
-    up_out_first_[i] = next;
-    for (const CchDownArc& a : metric_->upper_out(up_set_[i])) {
-      const std::uint32_t k = fill[heads_[next]]++;
-      up_slot_[next++] = k;
-      up_arcs_[k] = {i, a.arc};
-      up_weight_s_[k] = metric_->up_s(a.arc);
-    }
-  }
-  up_out_first_[up_set_.size()] = next;
-  up_range_.resize(up_set_.size());
-  up_parent_.resize(up_set_.size());
-  describe_up_members(0, up_set_.size());
-  find_meetings();
-}
-
-void CchSearchSpace::rebuild_up(std::vector<std::uint32_t> members, std::size_t shared) {
-  if (shared == 0) {
-    build_up(std::move(members));
-    return;
-  }
-  // The places below the shared top: [0, old_low) now, [0, low) in the new half. A shared member
-  // at new place h was at h - low + old_low.
+void CchSearchSpace::build_up(std::vector<std::uint32_t> members, std::size_t shared) {
+  // Arcs are filed under their higher end, as the sweep reads them; each list ascends by lower
+  // end, and so by arc id (ids ascend by lower end). The places below the shared top: [0, old_low)
+  // now, [0, low) in the new half. A shared member at new place h was at h - low + old_low.
   const std::size_t n = members.size();
   const auto low = static_cast<std::uint32_t>(n - shared);
   const auto old_low = static_cast<std::uint32_t>(up_set_.size() - shared);
@@ -139,7 +98,7 @@ void CchSearchSpace::rebuild_up(std::vector<std::uint32_t> members, std::size_t 
   nx.arcs.resize(nx.first.back());
   nx.weight_s.resize(nx.first.back());
   nx.fill.assign(nx.first.begin(), nx.first.end() - 1);
-  nx.slot.resize(heads_.size() + (up_slot_.size() - up_out_first_[old_low]));
+  nx.slot.resize(heads_.size() + (shared == 0 ? 0 : up_slot_.size() - up_out_first_[old_low]));
   nx.out_first.resize(n + 1);
   std::uint32_t next = 0;
   for (std::uint32_t i = 0; i < low; ++i) {
@@ -307,7 +266,7 @@ double CchSearchSpace::move_starts(std::vector<EdgePoint> starts) {
     start_ranks_ = from;
     std::vector<std::uint32_t> members;
     const std::size_t shared = ancestors_of_starts(from, members);
-    if (shared != up_set_.size() || members.size() != shared) rebuild_up(std::move(members), shared);
+    if (shared != up_set_.size() || members.size() != shared) build_up(std::move(members), shared);
   }
   refresh_start();
   return 0.0;

@@ -217,15 +217,13 @@ class CchSearchSpace {
   void build_down(std::vector<std::uint32_t> members);
   // The upward half from its members (the start vertices' ancestors, ascending): the arcs between
   // members open upward, filed under their higher end, with their weights; and the meeting
-  // vertices.
-  void build_up(std::vector<std::uint32_t> members);
-  // The same where the top `shared` members are the top of the half held now (the vehicle moved
-  // into another subtree of the same ancestors: on Porto a new start shares all but about 10 of
-  // its 240 ancestors). The arcs among the shared members, their weights as last reported, and
-  // their slots are carried over; only the new members' arcs are read from the metric, whose
-  // scattered lists made a move cost 0.27 ms in the slowest replans. The weights carried over are
-  // the metric's because every change of it is reported (arcs_changed), as D* Lite needs anyway.
-  void rebuild_up(std::vector<std::uint32_t> members, std::size_t shared);
+  // vertices. The top `shared` members are the top of the half held now (the vehicle moved into
+  // another subtree of the same ancestors: on Porto a new start shares all but about 10 of its 240
+  // ancestors): the arcs among them, their weights as last reported, and their slots are carried
+  // over, and only the other members' arcs are read from the metric, whose scattered lists made a
+  // move cost 0.27 ms in the slowest replans. The weights carried over are the metric's because
+  // every change of it is reported (arcs_changed), as D* Lite needs anyway.
+  void build_up(std::vector<std::uint32_t> members, std::size_t shared);
   // The start vertices' ancestors, ascending, into `out`: each start climbs the elimination tree
   // only until it meets the half held now, whose members' parents are kept (up_parent_), so that
   // a move reads the tree's scattered parent links only below the shared top. The count of
@@ -289,7 +287,7 @@ class CchSearchSpace {
   // and its last step.
   std::vector<double> up_cost_;
   std::vector<Step> up_step_;
-  // rebuild_up's new arrays, swapped with the ones above when done (kept, so that a move does not
+  // build_up's new arrays, swapped with the ones above when done (kept, so that a move does not
   // allocate the half's arrays again), and where each old slot went.
   struct UpArrays {
     std::vector<std::uint32_t> first, slot, out_first, parent, fill;

@@ -330,7 +330,7 @@ TEST(CchSearchSpace, StartArcsAreTheCheapestUpwardPathsWhileCostsChangeAndTheVeh
       space.for_each_successor(space.start(), [&](Vertex v, double c, const CchVia&) { kept.emplace_back(v, c); });
       fresh.for_each_successor(fresh.start(), [&](Vertex v, double c, const CchVia&) { built.emplace_back(v, c); });
       ASSERT_EQ(kept, built) << "seed " << seed << " step " << step;
-      // A half carried over from the last start (rebuild_up) finds a batch's vertices as one built
+      // A half carried over from the last start (build_up) finds a batch's vertices as one built
       // afresh does: a sparse batch, as settling reports, and a dense one, as a city's congestion.
       for (const std::uint32_t every : {40u, 3u}) {
         std::vector<std::uint32_t> batch;
