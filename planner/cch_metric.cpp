@@ -15,31 +15,37 @@ CchMetric::CchMetric(const CchTopology& topology, const TravelCost& cost, CchMet
     : topology_(&topology),
       cost_(&cost),
       options_(options),
-      up_(topology.arc_count(), kInfCost),
-      down_(topology.arc_count(), kInfCost),
-      via_up_(topology.arc_count()),
-      via_down_(topology.arc_count()),
+      up_(topology.arc_count()),
+      down_(topology.arc_count()),
+      slots_(std::size_t{topology.arc_count()} << (options.lazy_rises ? 2 : 1)),
+      lazy_shift_(options.lazy_rises ? 1 : 0),
       slot_(topology.arc_count(), 0),
       queue_(topology.arc_count()) {
   if (options_.lazy_rises) {
-    lazy_up_.resize(topology.arc_count());
-    lazy_down_.resize(topology.arc_count());
-    rival_up_.assign(topology.arc_count(), std::numeric_limits<float>::infinity());
-    rival_down_.assign(topology.arc_count(), std::numeric_limits<float>::infinity());
+    inputs_.resize(topology.arc_count());
+    for (std::uint32_t arc = 0; arc < topology.arc_count(); ++arc) {
+      for (const bool upward : {true, false}) {
+        slots_[slot_of(arc, upward) + 1].lazy = LazyWay{0, kNoCchArc, std::numeric_limits<float>::infinity(), 0};
+      }
+    }
   }
   if (&topology.turns() != &cost.graph().turns()) {
     throw std::invalid_argument("the contraction hierarchy was built for another graph than the cost model's");
   }
   open_ = open_inputs();
   customize_all(open_);
+  for (std::uint32_t arc = 0; arc < topology.arc_count(); ++arc) {
+    up_[arc] = way(arc, true).weight;
+    down_[arc] = way(arc, false).weight;
+  }
   build_open_lists();
   if (options_.lazy_rises) {
     // Every weight of a full customization is exact: found so in batch 1, before any change (and
     // no subtree has seen a rise since).
     marks_.resize(topology.vertex_count());
     for (std::uint32_t r = 0; r < topology.vertex_count(); ++r) marks_[r] = {batch_, topology.parent(r)};
-    for (auto* ways : {&lazy_up_, &lazy_down_}) {
-      for (LazyWay& w : *ways) w.exact = batch_;
+    for (std::uint32_t arc = 0; arc < topology.arc_count(); ++arc) {
+      for (const bool upward : {true, false}) lazy(arc, upward).exact = batch_;
     }
   }
 }
@@ -54,7 +60,7 @@ void CchMetric::mark_changed(std::uint32_t arc) {
 }
 
 void CchMetric::lower_rival(std::uint32_t arc, bool upward, double s) {
-  float& rival = upward ? rival_up_[arc] : rival_down_[arc];
+  float& rival = lazy(arc, upward).rival;
   if (s >= static_cast<double>(rival)) return;
   // The float at or below s: a bound rounded up could hide a cheaper way.
   float f = static_cast<float>(s);
@@ -75,12 +81,9 @@ void CchMetric::customize_all(HugePageVector<std::uint8_t>& open) {
   const CchTopology& t = *topology_;
   for (std::uint32_t arc = 0; arc < t.arc_count(); ++arc) {
     const CchTopology::Input& in = t.input(arc);
-    up_[arc] = in.up == kNoCchArc ? kInfCost : input_s(in.up);
-    down_[arc] = in.down == kNoCchArc ? kInfCost : input_s(in.down);
-    if (options_.lazy_rises) {
-      lazy_up_[arc].input = up_[arc];
-      lazy_down_[arc].input = down_[arc];
-    }
+    way(arc, true).weight = in.up == kNoCchArc ? kInfCost : input_s(in.up);
+    way(arc, false).weight = in.down == kNoCchArc ? kInfCost : input_s(in.down);
+    if (options_.lazy_rises) inputs_[arc] = {way(arc, true).weight, way(arc, false).weight};
   }
   // Basic customization: every lower triangle {x, a, b} (x lowest) offers a→x→b and b→x→a. Going
   // up by x, an arc's weight is final before any arc above it reads it. The same sweep opens a→b
@@ -91,8 +94,8 @@ void CchMetric::customize_all(HugePageVector<std::uint8_t>& open) {
     for (std::size_t i = 0; i < ups.size(); ++i) {
       const std::uint32_t xa = base + static_cast<std::uint32_t>(i);
       if (open[xa] == 0) continue;
-      const double a_to_x = down_[xa];
-      const double x_to_a = up_[xa];
+      const double a_to_x = way(xa, false).weight;
+      const double x_to_a = way(xa, true).weight;
       const bool a_to_x_open = (open[xa] & kDown) != 0, x_to_a_open = (open[xa] & kUp) != 0;
       // The higher neighbours of x above a are higher neighbours of a too (chordality): walk both
       // ascending lists together to find the arcs {a, b}.
@@ -104,19 +107,19 @@ void CchMetric::customize_all(HugePageVector<std::uint8_t>& open) {
         const std::uint32_t xb = base + static_cast<std::uint32_t>(j);
         if (a_to_x_open && (open[xb] & kUp) != 0) open[ab] |= kUp;    // a→x→b
         if (x_to_a_open && (open[xb] & kDown) != 0) open[ab] |= kDown;  // b→x→a
-        const double up = add_cost(a_to_x, up_[xb]);
-        const double down = add_cost(down_[xb], x_to_a);
+        const double up = add_cost(a_to_x, way(xb, true).weight);
+        const double down = add_cost(way(xb, false).weight, x_to_a);
         // A lazy metric keeps the best of the ways that lost (lower_rival).
-        if (up < up_[ab]) {
-          if (options_.lazy_rises) lower_rival(ab, true, up_[ab]);
-          up_[ab] = up;
+        if (up < way(ab, true).weight) {
+          if (options_.lazy_rises) lower_rival(ab, true, way(ab, true).weight);
+          way(ab, true).weight = up;
           set_witness(ab, true, Witness{xa, xb}, x);
         } else if (options_.lazy_rises) {
           lower_rival(ab, true, up);
         }
-        if (down < down_[ab]) {
-          if (options_.lazy_rises) lower_rival(ab, false, down_[ab]);
-          down_[ab] = down;
+        if (down < way(ab, false).weight) {
+          if (options_.lazy_rises) lower_rival(ab, false, way(ab, false).weight);
+          way(ab, false).weight = down;
           set_witness(ab, false, Witness{xa, xb}, x);
         } else if (options_.lazy_rises) {
           lower_rival(ab, false, down);
@@ -229,23 +232,21 @@ void CchMetric::queue(std::uint32_t arc, std::uint8_t derive) {
     pending_[slot_[arc] - 1].derive |= derive;
     return;
   }
-  pending_.push_back({up_[arc], down_[arc], derive});
+  pending_.push_back({way(arc, true).weight, way(arc, false).weight, derive});
   slot_[arc] = static_cast<std::uint32_t>(pending_.size());
   queue_.push(arc);
 }
 
 void CchMetric::prefetch_offer(std::uint32_t arc, bool upward) const {
-  __builtin_prefetch(upward ? &up_[arc] : &down_[arc], 1);
-  __builtin_prefetch(upward ? &via_up_[arc] : &via_down_[arc], 1);
-  if (options_.lazy_rises) __builtin_prefetch(upward ? &rival_up_[arc] : &rival_down_[arc], 1);
+  __builtin_prefetch(&way(arc, upward), 1);
 }
 
 void CchMetric::offer(std::uint32_t arc, bool upward, double old_s, double new_s, Witness via, std::uint32_t middle) {
-  double& current = upward ? up_[arc] : down_[arc];
+  const double current = way(arc, upward).weight;
   if (!options_.lazy_rises) {
     if (new_s < current) {
       queue(arc, 0);
-      current = new_s;
+      set_weight(arc, upward, new_s);
       set_witness(arc, upward, via, middle);
     } else if (new_s > old_s && old_s == current) {
       // The path through this triangle was (one of) the arc's cheapest and got dearer: only a
@@ -259,13 +260,13 @@ void CchMetric::offer(std::uint32_t arc, bool upward, double old_s, double new_s
   if (own != via) lower_rival(arc, upward, std::max(new_s, current));
   if (new_s < current) {
     queue(arc, 0);
-    current = new_s;
+    set_weight(arc, upward, new_s);
     set_witness(arc, upward, via, middle);
   } else if (new_s < old_s && own == via) {
     // The arc's own witness got cheaper and the weight did not move: the fall vanished in
     // rounding. The path under the weight changed all the same (a side took a new witness), so
     // the arc and every arc above it must be looked at again, as after a rise.
-    way(arc, upward).exact = 0;
+    lazy(arc, upward).exact = 0;
     mark_changed(arc);
   }
 }
@@ -325,36 +326,37 @@ CustomizationStats CchMetric::propagate(std::vector<std::uint32_t>& changed) {
     for (const bool upward : {true, false}) {
       if ((p.derive & (upward ? kUp : kDown)) == 0) continue;
       ++stats.recomputed;
-      double& w = upward ? up_[arc] : down_[arc];
+      Way& me = way(arc, upward);
+      const double w = me.weight;
       if (options_.lazy_rises) {
         // Only a cheaper input can move a lower bound down; a dearer one waits for settle(), and
         // from now on every weight whose path may use it is stale (mark_changed).
         const std::uint32_t input = upward ? t.input(arc).up : t.input(arc).down;
         const double in = input == kNoCchArc ? kInfCost : input_s(input);
-        LazyWay& lw = way(arc, upward);
-        const bool by_input = lw.middle == kNoCchArc;  // the witness is the input (set_witness)
-        if (in > lw.input) {
+        double& kept = upward ? inputs_[arc].up : inputs_[arc].down;
+        const bool by_input = lazy(arc, upward).middle == kNoCchArc;  // the witness is the input (set_witness)
+        if (in > kept) {
           mark_changed(arc);
           // A weight that is this input's cost is a real path's cost no longer.
-          if (by_input) lw.exact = 0;
+          if (by_input) lazy(arc, upward).exact = 0;
         }
-        lw.input = in;
+        kept = in;
         if (in < w) {
           // The witness that loses stays a way to derive the weight, at or above the weight.
           if (!by_input) lower_rival(arc, upward, w);
-          w = in;
+          set_weight(arc, upward, in);
           set_witness(arc, upward, Witness{}, kNoCchArc);
         } else if (!by_input) {
           lower_rival(arc, upward, in);
         }
       } else {
         const Derived d = derive(arc, upward);
-        w = d.weight;
-        (upward ? via_up_ : via_down_)[arc] = d.via;
+        set_weight(arc, upward, d.weight);
+        me.via = d.via;
       }
     }
-    const bool up_moved = up_[arc] != p.old_up;      // x→y
-    const bool down_moved = down_[arc] != p.old_down;  // y→x
+    const bool up_moved = way(arc, true).weight != p.old_up;      // x→y
+    const bool down_moved = way(arc, false).weight != p.old_down;  // y→x
     if (!up_moved && !down_moved) continue;
     ++stats.changed;
     changed.push_back(arc);
@@ -363,8 +365,8 @@ CustomizationStats CchMetric::propagate(std::vector<std::uint32_t>& changed) {
       // that did not move is exact still: it lies at or below today's cost, and a fall can only
       // have lowered that cost from the one it was found exact at, which is the weight itself.
       // So a fall marks only the weights it moves, where a rise marks its whole subtree.
-      if (up_moved) lazy_up_[arc].exact = 0;
-      if (down_moved) lazy_down_[arc].exact = 0;
+      if (up_moved) lazy(arc, true).exact = 0;
+      if (down_moved) lazy(arc, false).exact = 0;
     }
     // {x, y} is a lower side of every triangle {x, y, z} with z above x; the triangle's arc
     // between y and z is offered y→x→z (riding on y→x) and z→x→y (riding on x→y). Only open
@@ -412,8 +414,8 @@ CustomizationStats CchMetric::propagate(std::vector<std::uint32_t>& changed) {
       }
       for (const Offer& o : offers_) offer(o.arc, o.upward, add_cost(old_s, o.side), add_cost(new_s, o.side), o.via, x);
     };
-    if (down_moved) offer_triangles(true, p.old_down, down_[arc]);
-    if (up_moved) offer_triangles(false, p.old_up, up_[arc]);
+    if (down_moved) offer_triangles(true, p.old_down, way(arc, false).weight);
+    if (up_moved) offer_triangles(false, p.old_up, way(arc, true).weight);
   }
   pending_.clear();
   return stats;
@@ -437,25 +439,27 @@ void CchMetric::unpack(std::uint32_t arc, bool upward, std::vector<std::uint32_t
 }
 
 double CchMetric::settle(std::uint32_t arc, bool upward, std::vector<std::uint32_t>& raised) {
-  double& w = upward ? up_[arc] : down_[arc];
-  if (!options_.lazy_rises) return w;
+  // An eager metric's weights are exact: read where the searches read them, not the line beside.
+  if (!options_.lazy_rises) return upward ? up_[arc] : down_[arc];
+  const Way& me = way(arc, upward);
+  const double w = me.weight;
   if (known_exact(arc, upward)) return w;
   // The weight's own witness first: settled, it is the cost of a real path, and where that equals
   // the weight (the common case) the lower bound is attained, so exact.
-  LazyWay& me = way(arc, upward);
-  const Witness own = witness(arc, upward);
+  const Witness own = me.via;
   const auto settled_sum = [&](Witness z) {
     // x→z→y upward, y→z→x downward, z below both (as unpack follows them).
     return upward ? add_cost(settle(z.to_tail, false, raised), settle(z.to_head, true, raised))
                   : add_cost(settle(z.to_head, false, raised), settle(z.to_tail, true, raised));
   };
-  Derived best{me.input, Witness{}};
+  const double input = input_cost(arc, upward);
+  Derived best{input, Witness{}};
   double own_s = kInfCost;
   if (!own.input()) {
     own_s = settled_sum(own);
     if (own_s < best.weight) best = Derived{own_s, own};
   }
-  float& rival = upward ? rival_up_[arc] : rival_down_[arc];
+  float& rival = lazy(arc, upward).rival;
   if (best.weight != w && best.weight > static_cast<double>(rival)) {
     // The witness rose above another way's bound. Every weight is at most its triangles' sums and
     // its input (a fall is carried up at once, a rise only raises them), so each triangle's sum
@@ -465,7 +469,7 @@ double CchMetric::settle(std::uint32_t arc, bool upward, std::vector<std::uint32
     // as it is); once the next bound is no lower than the best settled sum, no triangle can beat
     // it. Settling raises weights only, so the bounds read stay bounds while the sides below them
     // are settled. What loses is the arc's new rival.
-    double rest = own.input() ? kInfCost : best.via == own ? me.input : own_s;
+    double rest = own.input() ? kInfCost : best.via == own ? input : own_s;
     const std::size_t base = candidates_.size();
     for_each_lower_triangle(arc, upward, [&](double s, Witness z) {
       if (z == own) return;
@@ -493,7 +497,7 @@ double CchMetric::settle(std::uint32_t arc, bool upward, std::vector<std::uint32
       // One side settled may already lift the sum to the best so far: the other side's weight
       // today is a lower bound of it, so the triangle loses without settling it.
       const double first = upward ? settle(c.via.to_tail, false, raised) : settle(c.via.to_head, false, raised);
-      const double partial = add_cost(first, upward ? up_[c.via.to_head] : up_[c.via.to_tail]);
+      const double partial = add_cost(first, way(upward ? c.via.to_head : c.via.to_tail, true).weight);
       if (partial >= best.weight) {
         rest = std::min(rest, partial);
         continue;
@@ -516,11 +520,13 @@ double CchMetric::settle(std::uint32_t arc, bool upward, std::vector<std::uint32
   assert(best.weight >= w);
   // A tie through another witness moves no weight: nothing for the planner to repair. The witness
   // moves all the same, so that the weight is its witness's cost.
-  if (best.weight != w) raised.push_back(arc);
-  w = best.weight;
+  if (best.weight != w) {
+    raised.push_back(arc);
+    set_weight(arc, upward, best.weight);
+  }
   if (best.via != own) set_witness(arc, upward, best.via, best.via.input() ? kNoCchArc : topology_->tail(best.via.to_tail));
-  me.exact = batch_;
-  return w;
+  lazy(arc, upward).exact = batch_;
+  return best.weight;
 }
 
 bool CchMetric::is_triangle(std::uint32_t arc, Witness w) const {
@@ -544,16 +550,16 @@ std::string CchMetric::invariant_violation() const {
     const double up = derive(arc, true).weight, down = derive(arc, false).weight;
     if (options_.lazy_rises) {
       // Lower bounds: at or below what the triangles and the input give; witnesses may have risen.
-      if (up_[arc] > up || down_[arc] > down) {
-        return "arc " + std::to_string(arc) + " holds " + std::to_string(up_[arc]) + "/" + std::to_string(down_[arc]) +
+      if (up_s(arc) > up || down_s(arc) > down) {
+        return "arc " + std::to_string(arc) + " holds " + std::to_string(up_s(arc)) + "/" + std::to_string(down_s(arc)) +
                " above what its triangles give, " + std::to_string(up) + "/" + std::to_string(down);
       }
       // The rival bounds every other way: the input where the witness is a triangle, and every
       // open lower triangle but the witness.
       for (const bool upward : {true, false}) {
-        const double rival = upward ? rival_up_[arc] : rival_down_[arc];
+        const double rival = lazy(arc, upward).rival;
         const Witness z = witness(arc, upward);
-        if (way(arc, upward).middle != (z.input() ? kNoCchArc : t.tail(z.to_tail))) {
+        if (lazy(arc, upward).middle != (z.input() ? kNoCchArc : t.tail(z.to_tail))) {
           return "arc " + std::to_string(arc) + (upward ? " up" : " down") + " keeps a middle not its witness's";
         }
         double other = z.input() ? kInfCost : input_cost(arc, upward);
@@ -569,7 +575,7 @@ std::string CchMetric::invariant_violation() const {
       // it would take as exact too: so, by induction, the cost of the path it unpacks to.
       for (const bool upward : {true, false}) {
         if (!known_exact(arc, upward)) continue;
-        const double w = upward ? up_[arc] : down_[arc];
+        const double w = way(arc, upward).weight;
         const Witness z = witness(arc, upward);
         double witnessed = input_cost(arc, upward);
         if (!z.input()) {
@@ -587,14 +593,14 @@ std::string CchMetric::invariant_violation() const {
       }
       continue;
     }
-    if (up != up_[arc] || down != down_[arc]) {
-      return "arc " + std::to_string(arc) + " holds " + std::to_string(up_[arc]) + "/" + std::to_string(down_[arc]) +
+    if (up != up_s(arc) || down != down_s(arc)) {
+      return "arc " + std::to_string(arc) + " holds " + std::to_string(up_s(arc)) + "/" + std::to_string(down_s(arc)) +
              " but its triangles give " + std::to_string(up) + "/" + std::to_string(down);
     }
     // Each finite weight's witness gives exactly it, so unpacking reproduces the weight.
     const CchTopology::Input& in = t.input(arc);
     for (const bool upward : {true, false}) {
-      const double w = upward ? up_[arc] : down_[arc];
+      const double w = way(arc, upward).weight;
       if (w >= kInfCost) continue;
       const Witness z = witness(arc, upward);
       const std::uint32_t input = upward ? in.up : in.down;
@@ -614,8 +620,7 @@ std::string CchMetric::invariant_violation() const {
 }
 
 std::size_t CchMetric::memory_bytes() const {
-  return (up_.size() + down_.size()) * sizeof(double) + (via_up_.size() + via_down_.size()) * sizeof(Witness) +
-         (lazy_up_.size() + lazy_down_.size()) * sizeof(LazyWay) + (rival_up_.size() + rival_down_.size()) * sizeof(float) +
+  return (up_.size() + down_.size()) * sizeof(double) + slots_.size() * sizeof(Slot) + inputs_.size() * sizeof(Inputs) +
          slot_.size() * sizeof(std::uint32_t) + marks_.size() * sizeof(TreeMark) +
          queue_.memory_bytes() +
          pending_.capacity() * sizeof(Pending) +

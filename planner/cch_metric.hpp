@@ -146,7 +146,8 @@ class CchMetric {
   void prefetch_offer(std::uint32_t arc, bool upward) const;
   // The sum over a triangle's sides today, the way asked: x→z→y upward, y→z→x downward.
   [[nodiscard]] double side_sum(Witness w, bool upward) const {
-    return upward ? add_cost(down_[w.to_tail], up_[w.to_head]) : add_cost(down_[w.to_head], up_[w.to_tail]);
+    return upward ? add_cost(way(w.to_tail, false).weight, way(w.to_head, true).weight)
+                  : add_cost(way(w.to_head, false).weight, way(w.to_tail, true).weight);
   }
   // Whether `w` names two arcs {z, x} and {z, y} below arc {x, y}; for invariant_violation().
   [[nodiscard]] bool is_triangle(std::uint32_t arc, Witness w) const;
@@ -158,20 +159,64 @@ class CchMetric {
   const CchTopology* topology_;
   const TravelCost* cost_;
   CchMetricOptions options_;
+  // The weights twice. In arrays of their own, for the searches, which read runs of an arc's
+  // neighbours (ids ascend by lower end, so a vertex's arcs up are consecutive): eight to a cache
+  // line.
   HugePageVector<double> up_;
   HugePageVector<double> down_;
-  // Each weight's witness: the two lower sides of the triangle whose sum it is, or none where it
-  // is the input turn's cost. Unpacking a route and settling follow them; kept as arc ids rather
-  // than the triangle's middle, so that neither searches the middle's arc list for them.
-  HugePageVector<Witness> via_up_;
-  HugePageVector<Witness> via_down_;
-  [[nodiscard]] const Witness& witness(std::uint32_t arc, bool upward) const {
-    return (upward ? via_up_ : via_down_)[arc];
+  // And beside what customization and settle() read of one arc direction, in 16 bytes, with a lazy
+  // metric's rest of it (below) in the next 16: a lazy metric's arc is one cache line, an eager
+  // one's half of one. Customization offers to arcs scattered over a metric far larger than the
+  // cache (over 100 MB on Porto), and settle() walks them; with a weight, its witness, its exact
+  // batch and its rival each in an array of its own, an arc cost up to four misses, and one known
+  // exact two (its batch, then its weight), besides the climb's mark.
+  struct Way {
+    double weight;
+    // The two lower sides of the triangle whose sum the weight is, or none where it is the input
+    // turn's cost. Unpacking a route and settling follow them; kept as arc ids rather than the
+    // triangle's middle, so that neither searches the middle's arc list for them.
+    Witness via;
+  };
+  // Lazy rises: the batch the weight was last found exact in, the witness's middle z (or
+  // kNoCchArc for the input; see batch_), and a lower bound of every other way to derive the
+  // weight (the input where the witness is a triangle, and every open lower triangle but the
+  // witness), rounded down to a float. Where the witness rose and its new sum is no dearer, the
+  // witness holds, and settle() need not read the arc's triangles (on Porto's slowest replans,
+  // about half the scans). Falls lower the rival as they are offered; rises only leave it lower
+  // than it could be.
+  struct LazyWay {
+    std::uint32_t exact;
+    std::uint32_t middle;
+    float rival;
+    std::uint32_t unused;
+  };
+  union alignas(16) Slot {
+    Way way;
+    LazyWay lazy;
+    Slot() : way{} {}
+  };
+  static_assert(sizeof(Slot) == 16);
+  // By arc, its up then its down direction: a Way each, followed by its LazyWay in a lazy metric.
+  HugePageVector<Slot> slots_;
+  std::uint32_t lazy_shift_ = 0;  // 1 in a lazy metric: two slots a direction
+  [[nodiscard]] std::size_t slot_of(std::uint32_t arc, bool upward) const {
+    return ((std::size_t{arc} << 1) | (upward ? 0U : 1U)) << lazy_shift_;
+  }
+  [[nodiscard]] Way& way(std::uint32_t arc, bool upward) { return slots_[slot_of(arc, upward)].way; }
+  [[nodiscard]] const Way& way(std::uint32_t arc, bool upward) const { return slots_[slot_of(arc, upward)].way; }
+  [[nodiscard]] LazyWay& lazy(std::uint32_t arc, bool upward) { return slots_[slot_of(arc, upward) + 1].lazy; }
+  [[nodiscard]] const LazyWay& lazy(std::uint32_t arc, bool upward) const {
+    return slots_[slot_of(arc, upward) + 1].lazy;
+  }
+  [[nodiscard]] const Witness& witness(std::uint32_t arc, bool upward) const { return way(arc, upward).via; }
+  void set_weight(std::uint32_t arc, bool upward, double w) {
+    way(arc, upward).weight = w;
+    (upward ? up_ : down_)[arc] = w;
   }
   // Sets a witness; `middle` is its triangle's lowest vertex z (tail(w.to_tail)), or kNoCchArc.
   void set_witness(std::uint32_t arc, bool upward, Witness w, std::uint32_t middle) {
-    (upward ? via_up_ : via_down_)[arc] = w;
-    if (options_.lazy_rises) way(arc, upward).middle = middle;
+    way(arc, upward).via = w;
+    if (options_.lazy_rises) lazy(arc, upward).middle = middle;
   }
   // A vertex's neighbours through open arc directions, each list ascending by neighbour: a CSR
   // per kind, indexed by rank. For a vertex v and a lower neighbour z: lower_out holds z where
@@ -216,31 +261,16 @@ class CchMetric {
     std::uint32_t parent;
   };
   HugePageVector<TreeMark> marks_;
-  // Lazy rises: what settle() reads of one arc direction to decide whether to look further, side
-  // by side: the walk visits arcs scattered over a metric far larger than the cache (over 100 MB
-  // on Porto), and an arc known exact then costs one line. (Weights, witnesses and rivals stay in
-  // arrays of their own: customization offers to runs of neighbouring arcs, which pack densely.)
-  struct alignas(16) LazyWay {
-    // The input's cost as of the last change reported for it. A rise is told from a fall by it,
-    // and settle() reads it instead of the graph and the overlay.
-    double input = kInfCost;
-    std::uint32_t exact = 0;           // the batch the weight was last found exact in
-    std::uint32_t middle = kNoCchArc;  // the witness's middle z, or kNoCchArc for the input
+  // Lazy rises: each input's cost as of the last change reported for it, both directions. A rise
+  // is told from a fall by it, and settle() reads it instead of the graph and the overlay.
+  struct Inputs {
+    double up = kInfCost;
+    double down = kInfCost;
   };
-  HugePageVector<LazyWay> lazy_up_, lazy_down_;
-  // Lazy rises: a lower bound of every other way to derive each weight (the input where the
-  // witness is a triangle, and every open lower triangle but the witness), rounded down to a
-  // float. Where the witness rose and its new sum is no dearer, the witness holds, and settle()
-  // need not read the arc's triangles (on Porto's slowest replans, about half the scans). Falls
-  // lower it as they are offered; rises only leave it lower than it could be.
-  HugePageVector<float> rival_up_, rival_down_;
-  [[nodiscard]] LazyWay& way(std::uint32_t arc, bool upward) { return (upward ? lazy_up_ : lazy_down_)[arc]; }
-  [[nodiscard]] const LazyWay& way(std::uint32_t arc, bool upward) const {
-    return (upward ? lazy_up_ : lazy_down_)[arc];
-  }
+  HugePageVector<Inputs> inputs_;
   void lower_rival(std::uint32_t arc, bool upward, double s);
   [[nodiscard]] double input_cost(std::uint32_t arc, bool upward) const {
-    if (options_.lazy_rises) return way(arc, upward).input;
+    if (options_.lazy_rises) return upward ? inputs_[arc].up : inputs_[arc].down;
     const std::uint32_t input = upward ? topology_->input(arc).up : topology_->input(arc).down;
     return input == kNoCchArc ? kInfCost : input_s(input);
   }
@@ -250,7 +280,7 @@ class CchMetric {
   // below the arc's ends; its sides' witnesses lie below z in turn), so only a rise below z can
   // have changed its cost. A weight that is its input's cost is reset (0) when that input rises.
   [[nodiscard]] bool known_exact(std::uint32_t arc, bool upward) const {
-    const LazyWay& w = way(arc, upward);
+    const LazyWay& w = lazy(arc, upward);
     if (w.exact == 0) return false;
     return w.middle == kNoCchArc || w.exact >= marks_[w.middle].changed_below;
   }
