@@ -17,7 +17,7 @@ CchMetric::CchMetric(const CchTopology& topology, const TravelCost& cost, CchMet
       options_(options),
       up_(topology.arc_count()),
       down_(topology.arc_count()),
-      slots_(std::size_t{topology.arc_count()} << (options.lazy_rises ? 2 : 1)),
+      ways_(std::size_t{topology.arc_count()} << (options.lazy_rises ? 2 : 1)),
       lazy_shift_(options.lazy_rises ? 1 : 0),
       slot_(topology.arc_count(), 0),
       queue_(topology.arc_count()) {
@@ -25,7 +25,7 @@ CchMetric::CchMetric(const CchTopology& topology, const TravelCost& cost, CchMet
     inputs_.resize(topology.arc_count());
     for (std::uint32_t arc = 0; arc < topology.arc_count(); ++arc) {
       for (const bool upward : {true, false}) {
-        slots_[slot_of(arc, upward) + 1].lazy = LazyWay{0, kNoCchArc, std::numeric_limits<float>::infinity(), 0};
+        ways_[place_of(arc, upward) + 1].lazy = LazyWay{0, kNoCchArc, std::numeric_limits<float>::infinity(), 0};
       }
     }
   }
@@ -448,6 +448,10 @@ double CchMetric::settle(std::uint32_t arc, bool upward, std::vector<std::uint32
   // the weight (the common case) the lower bound is attained, so exact.
   const Witness own = me.via;
   const auto settled_sum = [&](Witness z) {
+    // Both sides' lines asked for at once, so that their misses overlap: the first side's walk
+    // may go deep before the second is read.
+    __builtin_prefetch(&way(z.to_tail, !upward));
+    __builtin_prefetch(&way(z.to_head, upward));
     // x→z→y upward, y→z→x downward, z below both (as unpack follows them).
     return upward ? add_cost(settle(z.to_tail, false, raised), settle(z.to_head, true, raised))
                   : add_cost(settle(z.to_head, false, raised), settle(z.to_tail, true, raised));
@@ -496,6 +500,7 @@ double CchMetric::settle(std::uint32_t arc, bool upward, std::vector<std::uint32
       }
       // One side settled may already lift the sum to the best so far: the other side's weight
       // today is a lower bound of it, so the triangle loses without settling it.
+      __builtin_prefetch(&way(upward ? c.via.to_head : c.via.to_tail, true));
       const double first = upward ? settle(c.via.to_tail, false, raised) : settle(c.via.to_head, false, raised);
       const double partial = add_cost(first, way(upward ? c.via.to_head : c.via.to_tail, true).weight);
       if (partial >= best.weight) {
@@ -620,7 +625,7 @@ std::string CchMetric::invariant_violation() const {
 }
 
 std::size_t CchMetric::memory_bytes() const {
-  return (up_.size() + down_.size()) * sizeof(double) + slots_.size() * sizeof(Slot) + inputs_.size() * sizeof(Inputs) +
+  return (up_.size() + down_.size()) * sizeof(double) + ways_.size() * sizeof(Slot) + inputs_.size() * sizeof(Inputs) +
          slot_.size() * sizeof(std::uint32_t) + marks_.size() * sizeof(TreeMark) +
          queue_.memory_bytes() +
          pending_.capacity() * sizeof(Pending) +
