@@ -389,9 +389,9 @@ CustomizationStats CchMetric::propagate(std::vector<std::uint32_t>& changed) {
     };
     // The triangles riding on one direction of {x, y} that moved: y→x→z (on y→x, through open
     // x→z) `from_y`, z→x→y (on x→y, through open z→x) otherwise.
-    // In two passes: the offers read and write arcs scattered over the metric (their weight,
-    // witness and rival, three cache misses each), so the arcs are gathered and their lines
-    // fetched first, and the misses overlap instead of coming one after another. The offers
+    // In two passes: the offers read and write arcs scattered over the metric (an arc direction's
+    // weight, witness and rival share a line, and a lowered weight is written to the searches'
+    // array too), so the arcs are gathered and their lines fetched first, and the misses overlap instead of coming one after another. The offers
     // change only arcs above x, none of x's own, so the sides read in the first pass still hold.
     const auto offer_triangles = [&](bool from_y, double old_s, double new_s) {
       std::size_t k = 0, m = 0;
@@ -551,6 +551,10 @@ std::string CchMetric::invariant_violation() const {
         return "arc " + std::to_string(arc) + (upward ? " up" : " down") + " keeps input cost " +
                std::to_string(input_cost(arc, upward)) + " but the turn costs " + std::to_string(today) + " today";
       }
+    }
+    // The searches' copies of the weights are the metric's own (set_weight writes both).
+    if (up_[arc] != way(arc, true).weight || down_[arc] != way(arc, false).weight) {
+      return "arc " + std::to_string(arc) + "'s weights for the searches differ from the metric's";
     }
     const double up = derive(arc, true).weight, down = derive(arc, false).weight;
     if (options_.lazy_rises) {

@@ -14,6 +14,7 @@
 // (a "directed hierarchy").
 #pragma once
 
+#include <cassert>
 #include <cstdint>
 #include <limits>
 #include <span>
@@ -170,8 +171,10 @@ class CchMetric {
   // cache (over 100 MB on Porto), and settle() walks them; with a weight, its witness, its exact
   // batch and its rival each in an array of its own, an offer cost three misses, and an arc known
   // exact three (its batch, the climb's mark, then its weight), where it now costs two. An eager
-  // metric has no lazy fields, and its arcs stay 32 bytes: one layout for both grew it by 60 MB on
-  // Porto and slowed its searches by the larger footprint.
+  // metric has no lazy fields: 32 bytes an arc here, 48 with the dense weights (32 before); one
+  // layout for both grew it by 60 MB on Porto, not 20, and slowed its searches by the larger
+  // footprint. (A line per lazy arc where the array is 64-byte aligned, as huge-page arrays are;
+  // a small map's array may straddle lines, which costs only speed.)
   struct Way {
     double weight;
     // The two lower sides of the triangle whose sum the weight is, or none where it is the input
@@ -207,8 +210,13 @@ class CchMetric {
   }
   [[nodiscard]] Way& way(std::uint32_t arc, bool upward) { return ways_[place_of(arc, upward)].way; }
   [[nodiscard]] const Way& way(std::uint32_t arc, bool upward) const { return ways_[place_of(arc, upward)].way; }
-  [[nodiscard]] LazyWay& lazy(std::uint32_t arc, bool upward) { return ways_[place_of(arc, upward) + 1].lazy; }
+  // Lazy metrics only: an eager one has no such slot, and the place would be the next Way.
+  [[nodiscard]] LazyWay& lazy(std::uint32_t arc, bool upward) {
+    assert(options_.lazy_rises);
+    return ways_[place_of(arc, upward) + 1].lazy;
+  }
   [[nodiscard]] const LazyWay& lazy(std::uint32_t arc, bool upward) const {
+    assert(options_.lazy_rises);
     return ways_[place_of(arc, upward) + 1].lazy;
   }
   [[nodiscard]] const Witness& witness(std::uint32_t arc, bool upward) const { return way(arc, upward).via; }
