@@ -23,9 +23,11 @@ CchMetric::CchMetric(const CchTopology& topology, const TravelCost& cost, CchMet
       queue_(topology.arc_count()) {
   if (options_.lazy_rises) {
     inputs_.resize(topology.arc_count());
+    // Every weight of the full customization below is exact: found so in batch 1, before any
+    // change (and no subtree has seen a rise since).
     for (std::uint32_t arc = 0; arc < topology.arc_count(); ++arc) {
       for (const bool upward : {true, false}) {
-        ways_[place_of(arc, upward) + 1].lazy = LazyWay{0, kNoCchArc, std::numeric_limits<float>::infinity(), 0};
+        ways_[place_of(arc, upward) + 1].lazy = LazyWay{batch_, kNoCchArc, std::numeric_limits<float>::infinity(), 0};
       }
     }
   }
@@ -40,13 +42,8 @@ CchMetric::CchMetric(const CchTopology& topology, const TravelCost& cost, CchMet
   }
   build_open_lists();
   if (options_.lazy_rises) {
-    // Every weight of a full customization is exact: found so in batch 1, before any change (and
-    // no subtree has seen a rise since).
     marks_.resize(topology.vertex_count());
     for (std::uint32_t r = 0; r < topology.vertex_count(); ++r) marks_[r] = {batch_, topology.parent(r)};
-    for (std::uint32_t arc = 0; arc < topology.arc_count(); ++arc) {
-      for (const bool upward : {true, false}) lazy(arc, upward).exact = batch_;
-    }
   }
 }
 
@@ -391,8 +388,9 @@ CustomizationStats CchMetric::propagate(std::vector<std::uint32_t>& changed) {
     // x→z) `from_y`, z→x→y (on x→y, through open z→x) otherwise.
     // In two passes: the offers read and write arcs scattered over the metric (an arc direction's
     // weight, witness and rival share a line, and a lowered weight is written to the searches'
-    // array too), so the arcs are gathered and their lines fetched first, and the misses overlap instead of coming one after another. The offers
-    // change only arcs above x, none of x's own, so the sides read in the first pass still hold.
+    // array too), so the arcs are gathered and their lines fetched first, and the misses overlap
+    // instead of coming one after another. The offers change only arcs above x, none of x's own,
+    // so the sides read in the first pass still hold.
     const auto offer_triangles = [&](bool from_y, double old_s, double new_s) {
       std::size_t k = 0, m = 0;
       offers_.clear();
