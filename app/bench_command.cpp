@@ -112,6 +112,11 @@ void register_bench_command(CLI::App& app) {
                     "0, or the real-time (SCHED_FIFO) priority of repairs, as serve's --repair-priority")
       ->check(CLI::Range(0, 99))
       ->capture_default_str();
+  serve->add_option("--background-nice", s->second.background_nice,
+                    "nice steps the server's I/O threads and commit writer take below its repairs, as serve's "
+                    "--background-nice (the load generator's threads keep theirs)")
+      ->check(CLI::Range(0, 19))
+      ->capture_default_str();
   add_planner_graph_option(*serve, s->second.planner_graph);
   serve->callback([s] {
     const maps::RoadGraph graph = load_map_from_options(s->first);

@@ -31,6 +31,7 @@ struct ServeOptions {
   int threads = 2;
   int repair_threads = 0;  // 0: server::default_repair_threads(threads)
   int repair_priority = 0;
+  int background_nice = 10;
   bool demo = false;
   server::PlannerGraph planner_graph = server::PlannerGraph::automatic;
 };
@@ -94,6 +95,8 @@ void run_serve(const ServeOptions& o) {
   server::DispatchConfig dispatch;
   dispatch.repair_threads = o.repair_threads > 0 ? o.repair_threads : server::default_repair_threads(o.threads);
   dispatch.repair_realtime_priority = o.repair_priority;
+  dispatch.background_nice = o.background_nice;
+  limits.io_nice = o.background_nice;
   dispatch.planner_graph = o.planner_graph;
   server::DispatchService service(graph, maps::signal_plans_for(map_file, graph), dispatch, &store, now());
   std::vector<server::StaticAsset> console;
@@ -179,6 +182,12 @@ void register_serve_command(CLI::App& app) {
                   "0, or the real-time (SCHED_FIFO) priority repairs after a congestion change run at, so other "
                   "work cannot preempt them (needs root or CAP_SYS_NICE; docs/routing.md)")
       ->check(CLI::Range(0, 99))
+      ->capture_default_str();
+  cmd->add_option("--background-nice", o->background_nice,
+                  "nice steps the I/O threads (position reports, the event stream) and the commit writer take below "
+                  "the threads that plan and repair routes, so a contended core goes to repairs first (0 = all "
+                  "equal; needs no privilege; docs/routing.md)")
+      ->check(CLI::Range(0, 19))
       ->capture_default_str();
   add_planner_graph_option(*cmd, o->planner_graph);
   cmd->add_flag("--demo", o->demo,

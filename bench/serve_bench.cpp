@@ -211,11 +211,14 @@ json run_serve_bench(const maps::RoadGraph& graph, const ServeBenchConfig& c) {
   dispatch.repair_threads = c.repair_threads > 0 ? c.repair_threads : server::default_repair_threads(c.server_threads);
   dispatch.planner_graph = c.planner_graph;
   dispatch.repair_realtime_priority = c.repair_realtime_priority;
+  dispatch.background_nice = c.background_nice;
+  server::ServerLimits limits;
+  limits.io_nice = c.background_nice;
   server::DispatchService service(graph, dispatch, &store, now());
   server::TokenAuth auth;
   auth.add(kToken, {"bench", server::kAllRoles, std::nullopt});
   server::Router router(service, std::move(auth), {}, now);
-  server::HttpServer http(router, service, {}, "127.0.0.1", 0, c.server_threads);
+  server::HttpServer http(router, service, limits, "127.0.0.1", 0, c.server_threads);
   std::thread server_thread([&] { http.run(); });
   const unsigned short port = http.port();
 
@@ -338,7 +341,8 @@ json run_serve_bench(const maps::RoadGraph& graph, const ServeBenchConfig& c) {
   }
   out["config"] = {{"vehicles", c.vehicles}, {"missions", c.missions}, {"congestion_edges_per_s", c.congestion_edges_per_s},
                    {"seconds", c.seconds}, {"rate_per_s", c.rate_per_s}, {"client_threads", c.client_threads}, {"server_threads", c.server_threads},
-                   {"repair_threads", dispatch.repair_threads}, {"repair_priority", c.repair_realtime_priority}};
+                   {"repair_threads", dispatch.repair_threads}, {"repair_priority", c.repair_realtime_priority},
+                   {"background_nice", c.background_nice}};
   // Whether the real-time priority asked for was granted (null: not asked).
   const auto granted = service.repair_realtime_granted();
   out["config"]["repair_priority_granted"] = granted ? json(*granted) : json(nullptr);

@@ -25,6 +25,7 @@ struct ServeBenchConfig {
   // 0 = as serve chooses (server::default_repair_threads: half of server_threads, at least 1).
   int repair_threads = 0;
   int repair_realtime_priority = 0;  // DispatchConfig's
+  int background_nice = 10;          // DispatchConfig's and ServerLimits::io_nice
   server::PlannerGraph planner_graph = server::PlannerGraph::automatic;
   std::uint64_t seed = 1;
 };

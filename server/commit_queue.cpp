@@ -1,5 +1,7 @@
 #include "server/commit_queue.hpp"
 
+#include "server/thread_priority.hpp"
+
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -42,8 +44,11 @@ void CommitTicket::complete(std::optional<std::string> error) {
   if (then) then(error_ ? &*error_ : nullptr);
 }
 
-CommitQueue::CommitQueue(Store& store, std::size_t max_batch)
-    : store_(store), max_batch_(std::max<std::size_t>(1, max_batch)), writer_([this] { loop(); }) {}
+CommitQueue::CommitQueue(Store& store, std::size_t max_batch, int lower_priority_by)
+    : store_(store), max_batch_(std::max<std::size_t>(1, max_batch)), writer_([this, lower_priority_by] {
+        lower_thread_priority(lower_priority_by);
+        loop();
+      }) {}
 
 CommitQueue::~CommitQueue() {
   {

@@ -46,8 +46,9 @@ class CommitQueue {
  public:
   using Write = std::function<void(Store&)>;
 
-  // Starts the writer thread. The store must outlive the queue.
-  explicit CommitQueue(Store& store, std::size_t max_batch = 2048);
+  // Starts the writer thread. The store must outlive the queue. The writer's nice value is raised by
+  // `lower_priority_by` (lower_thread_priority), so that it yields a contended core to repairs.
+  explicit CommitQueue(Store& store, std::size_t max_batch = 2048, int lower_priority_by = 0);
   // Commits everything already submitted, then stops.
   ~CommitQueue();
   CommitQueue(const CommitQueue&) = delete;

@@ -89,6 +89,9 @@ DispatchService::DispatchService(const maps::RoadGraph& graph, std::unordered_ma
   // expected delay.
   overlay_.set_signal_delay(graph, config_.signal_delay_s);
   preemption::set_signal_costs(overlay_, graph, plans_, preemption::SignalCostRule::preempted);
+  if (config_.background_nice < 0 || config_.background_nice > 19) {
+    throw std::invalid_argument("background_nice must be 0..19, not " + std::to_string(config_.background_nice));
+  }
   if (!(config_.max_hierarchy_density > 0.0)) {
     throw std::invalid_argument("max_hierarchy_density must be positive, not " + std::to_string(config_.max_hierarchy_density));
   }
@@ -110,7 +113,7 @@ DispatchService::DispatchService(const maps::RoadGraph& graph, std::unordered_ma
     repair_pool_ = std::make_unique<boost::asio::thread_pool>(static_cast<std::size_t>(config_.repair_threads - 1));
   }
   if (store_ != nullptr) {
-    commits_ = std::make_unique<CommitQueue>(*store_);
+    commits_ = std::make_unique<CommitQueue>(*store_, 2048, config_.background_nice);
     restore(now_s);
   }
 }

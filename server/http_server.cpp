@@ -10,6 +10,7 @@
 #include <mutex>
 
 #include "server/json_codec.hpp"
+#include "server/thread_priority.hpp"
 
 namespace corridor::server {
 
@@ -336,8 +337,12 @@ void HttpServer::run() {
   impl_->tick();
   impl_->signals.async_wait([this](beast::error_code, int) { stop(); });
   std::vector<std::thread> pool;
-  for (std::size_t i = 1; i < impl_->shards.size(); ++i) pool.emplace_back([this, i] { impl_->shards[i]->run(); });
-  impl_->ioc.run();
+  for (std::size_t i = 0; i < impl_->shards.size(); ++i) {
+    pool.emplace_back([this, i] {
+      lower_thread_priority(impl_->limits.io_nice);
+      impl_->shards[i]->run();
+    });
+  }
   for (auto& t : pool) t.join();
 }
 

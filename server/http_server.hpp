@@ -19,6 +19,9 @@ struct ServerLimits {
   std::size_t header_limit_bytes = 16 << 10;
   int read_timeout_s = 30;
   std::size_t max_queued_events = 4096;  // a WebSocket client this far behind is disconnected
+  // Nice steps (0..19) the I/O threads (position reports, the event stream) take below the workers
+  // that plan and repair routes: as DispatchConfig::background_nice, for the same reason.
+  int io_nice = 10;
 };
 
 class HttpServer {
@@ -31,8 +34,8 @@ class HttpServer {
   HttpServer& operator=(const HttpServer&) = delete;
 
   [[nodiscard]] unsigned short port() const;
-  // Runs until stop(), SIGINT or SIGTERM, on `threads` threads, one io_context each; ticks the
-  // service once a second.
+  // Runs until stop(), SIGINT or SIGTERM, on `threads` threads of its own, one io_context each
+  // (the calling thread waits for them, its priority untouched); ticks the service once a second.
   void run();
   void stop();
 

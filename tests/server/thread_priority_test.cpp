@@ -1,0 +1,107 @@
+#include "server/thread_priority.hpp"
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "server/commit_queue.hpp"
+#include "server/dispatch_service.hpp"
+#include "server/http_server.hpp"
+#include "server/router.hpp"
+#include "tests/server/api_fixture.hpp"
+#include "tests/server/temp_db.hpp"
+
+namespace corridor::server {
+namespace {
+
+int own_nice() { return getpriority(PRIO_PROCESS, static_cast<id_t>(gettid())); }
+
+// The nice value of every thread of this process, read as the kernel reports it (field 19 of
+// /proc/self/task/<tid>/stat, after the command's closing parenthesis).
+std::vector<int> thread_nices() {
+  std::vector<int> out;
+  for (const auto& task : std::filesystem::directory_iterator("/proc/self/task")) {
+    std::ifstream in(task.path() / "stat");
+    std::string stat((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const auto close = stat.rfind(')');
+    if (close == std::string::npos) continue;
+    std::istringstream fields(stat.substr(close + 2));
+    std::string field;
+    // Fields 3.. follow the parenthesis; nice is field 19, the 17th of them.
+    for (int i = 3; i <= 19 && fields >> field; ++i) {
+      if (i == 19) out.push_back(std::stoi(field));
+    }
+  }
+  return out;
+}
+
+TEST(LowerThreadPriority, RaisesOnlyTheCallersNiceAndCapsItAt19) {
+  const int main_before = own_nice();
+  std::thread worker([&] {
+    const int before = own_nice();
+    ASSERT_LE(before, 10);
+    EXPECT_TRUE(lower_thread_priority(0));
+    EXPECT_EQ(own_nice(), before);
+    EXPECT_TRUE(lower_thread_priority(3));
+    EXPECT_EQ(own_nice(), before + 3);
+    EXPECT_TRUE(lower_thread_priority(40));
+    EXPECT_EQ(own_nice(), 19);
+  });
+  worker.join();
+  EXPECT_EQ(own_nice(), main_before);
+}
+
+TEST(LowerThreadPriority, TheCommitWriterRunsBelowItsCreator) {
+  TempDb db;
+  Store store(db.path());
+  const int creator = own_nice();
+  ASSERT_LE(creator, 10);
+  int writer = -100;
+  {
+    CommitQueue queue(store, 2048, 4);
+    // A write runs on the writer thread: it reads that thread's own nice value.
+    queue.run([&](Store&) { writer = own_nice(); });
+  }
+  EXPECT_EQ(writer, creator + 4);
+  EXPECT_EQ(own_nice(), creator);
+}
+
+TEST(LowerThreadPriority, TheServersIoThreadsRunBelowItsWorkersAndTheCallerKeepsItsOwn) {
+  const int base = own_nice();
+  ASSERT_LE(base, 10);
+  const auto count = [](const std::vector<int>& nices, int value) { return std::count(nices.begin(), nices.end(), value); };
+  const auto before = count(thread_nices(), base + 6);
+  DispatchService service(testing::api_grid(), {}, nullptr, 0.0);
+  Router router(service, testing::api_auth(), {}, [] { return 100.0; });
+  ServerLimits limits;
+  limits.io_nice = 6;
+  HttpServer http(router, service, limits, "127.0.0.1", 0, 3);
+  int runner_after = -100;
+  std::thread runner([&] {
+    http.run();
+    runner_after = own_nice();
+  });
+  // The three I/O threads lower themselves as they start.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (count(thread_nices(), base + 6) < before + 3 && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  EXPECT_EQ(count(thread_nices(), base + 6), before + 3);
+  http.stop();
+  runner.join();
+  EXPECT_EQ(runner_after, base);
+}
+
+}  // namespace
+}  // namespace corridor::server
