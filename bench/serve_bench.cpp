@@ -196,6 +196,16 @@ json histogram_from_metrics(const std::string& text, const std::string& name, co
   return out;
 }
 
+// A Prometheus counter read back from the server's /metrics (0 where it was never counted).
+double counter_from_metrics(const std::string& text, const std::string& name) {
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind(name + ' ', 0) == 0) return std::stod(line.substr(name.size() + 1));
+  }
+  return 0.0;
+}
+
 }  // namespace
 
 json run_serve_bench(const maps::RoadGraph& graph, const ServeBenchConfig& c) {
@@ -368,6 +378,9 @@ json run_serve_bench(const maps::RoadGraph& graph, const ServeBenchConfig& c) {
   // Every single mission repair the congestion caused, from the server's own histogram.
   out["congestion"]["mission_replans"] =
       histogram_from_metrics(metrics_status == 200 ? metrics_text : "", "corridor_congestion_mission_replan_seconds");
+  // Missions a position report had already repaired when their batch reached them: not sampled.
+  out["congestion"]["mission_replans"]["repaired_by_reports"] = static_cast<std::uint64_t>(
+      counter_from_metrics(metrics_status == 200 ? metrics_text : "", "corridor_congestion_missions_repaired_by_reports_total"));
   // The same repairs in their thread's CPU time: what the repair costs, without waiting for a core.
   out["congestion"]["mission_replans_cpu"] =
       histogram_from_metrics(metrics_status == 200 ? metrics_text : "", "corridor_congestion_mission_replan_cpu_seconds");

@@ -46,7 +46,10 @@ void CommitTicket::complete(std::optional<std::string> error) {
 
 CommitQueue::CommitQueue(Store& store, std::size_t max_batch, int lower_priority_by)
     : store_(store), max_batch_(std::max<std::size_t>(1, max_batch)), writer_([this, lower_priority_by] {
-        lower_thread_priority(lower_priority_by);
+        if (!lower_thread_priority(lower_priority_by)) {
+          spdlog::warn("event=writer_nice_denied nice_steps={} hint=\"the commit writer runs at the process's priority\"",
+                       lower_priority_by);
+        }
         loop();
       }) {}
 

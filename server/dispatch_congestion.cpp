@@ -160,10 +160,15 @@ void DispatchService::repair_one(Mission& m, double now_s, CongestionResult& res
   const std::optional<std::string> reason = repair(m, nullptr);
   const double cpu_s = thread_cpu_s() - cpu_started;
   const double took_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  if (!reason) {
+    // A position report took the batch's changes into the plan first (on its own thread): no
+    // repair was left to do here, and the route check above is not one, so it is not sampled.
+    ++result.missions_repaired_by_reports;
+    return;
+  }
   result.mission_replan_cpu_s.push_back(cpu_s);
   result.slowest_replan_s = std::max(result.slowest_replan_s, took_s);
   result.mission_replan_s.push_back(took_s);
-  if (!reason) return;  // a position report repaired it in the meantime
   Staged staged;
   if (m.route.edges != before) {
     ++result.routes_changed;
@@ -205,6 +210,7 @@ CongestionResult DispatchService::repair_plans(const std::vector<MissionPtr>& mi
     std::lock_guard lock(merge_mutex);
     result.missions_replanned += mine.missions_replanned;
     result.routes_changed += mine.routes_changed;
+    result.missions_repaired_by_reports += mine.missions_repaired_by_reports;
     result.slowest_replan_s = std::max(result.slowest_replan_s, mine.slowest_replan_s);
     result.mission_replan_s.insert(result.mission_replan_s.end(), mine.mission_replan_s.begin(), mine.mission_replan_s.end());
     result.mission_replan_cpu_s.insert(result.mission_replan_cpu_s.end(), mine.mission_replan_cpu_s.begin(),

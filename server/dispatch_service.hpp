@@ -69,11 +69,13 @@ struct DispatchConfig {
   // price is position acknowledgements held behind the batch (docs/routing.md). Needs root,
   // CAP_SYS_NICE or RLIMIT_RTPRIO; without them the threads keep their scheduling, with a warning.
   int repair_realtime_priority = 0;
-  // Nice steps (0..19) that the commit writer takes below the repairs; HttpServer's I/O threads
-  // take ServerLimits::io_nice. The repairs run at the process's own priority: where the cores
-  // are contended they are served first, with no privilege needed, and the position reports and
-  // the journal still progress (at nice 10, a tenth of a repair's share). On 2 cores, Porto, 200
-  // missions, 2,000 positions/s: repairs within 2 ms 98.2-98.8 % at 0, 99.6-99.7 % at 10 (docs/routing.md).
+  // Nice steps (0..19) that the commit writer takes below the process's own priority, at which the
+  // workers run (mission creation, congestion batches and their repairs, ticks); HttpServer's I/O
+  // threads take ServerLimits::io_nice. Where the cores are contended a batch's repairs are then
+  // served first, with no privilege needed, and the position reports (each of which repairs its
+  // own mission, on its I/O thread) and the journal still progress, at nice 10 with a tenth of a
+  // worker's share. On 2 cores, Porto, 200 missions, 2,000 positions/s: the batch's repairs within
+  // 2 ms 98.6-98.8 % at 0, 99.6-99.7 % at 10 (docs/routing.md).
   int background_nice = 10;
   PlannerGraph planner_graph = PlannerGraph::automatic;
   // Arcs per vertex above which `automatic` keeps the turn graph: road networks measure 6 to 10, a

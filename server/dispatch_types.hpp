@@ -112,12 +112,16 @@ struct CongestionResult {
   std::size_t edges_changed = 0;
   std::size_t missions_replanned = 0;
   std::size_t routes_changed = 0;
+  // Of missions_replanned, those a position report had already repaired with this batch's changes
+  // by the time the batch reached them; the samples below leave them out.
+  std::size_t missions_repaired_by_reports = 0;
   // From the call's start to the last mission's repaired route: what a dispatcher waits, at most,
   // to see the effect of a congestion report (before its writes are durable).
   double replan_latency_s = 0;
   // The longest single mission's D* Lite repair in this batch (its own lock held, costs read).
   double slowest_replan_s = 0;
-  // Each repaired mission's D* Lite repair time, in no particular order: the per-replan latency.
+  // Each mission's D* Lite repair time, in no particular order: the per-replan latency (the
+  // batch's own repairs, not missions_repaired_by_reports).
   std::vector<double> mission_replan_s;
   // The same repairs in the repairing thread's own CPU time: the work, without the time the
   // thread waited for a core (on a loaded machine the two differ by the scheduler's slices).

@@ -8,6 +8,8 @@
 #include <chrono>
 #include <deque>
 #include <mutex>
+#include <stdexcept>
+#include <string>
 
 #include "server/json_codec.hpp"
 #include "server/thread_priority.hpp"
@@ -226,6 +228,13 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   net::thread_pool& workers_;
 };
 
+ServerLimits checked(ServerLimits limits) {
+  if (limits.io_nice < 0 || limits.io_nice > 19) {
+    throw std::invalid_argument("io_nice must be 0..19, not " + std::to_string(limits.io_nice));
+  }
+  return limits;
+}
+
 }  // namespace
 
 struct HttpServer::Impl {
@@ -303,7 +312,7 @@ struct HttpServer::Impl {
 
 HttpServer::HttpServer(Router& router, DispatchService& service, ServerLimits limits, const std::string& address,
                        unsigned short port, int threads)
-    : impl_(std::make_unique<Impl>(router, service, limits, threads)) {
+    : impl_(std::make_unique<Impl>(router, service, checked(limits), threads)) {
   const tcp::endpoint endpoint{net::ip::make_address(address), port};
   impl_->acceptor.open(endpoint.protocol());
   impl_->acceptor.set_option(net::socket_base::reuse_address(true));
@@ -339,7 +348,9 @@ void HttpServer::run() {
   std::vector<std::thread> pool;
   for (std::size_t i = 0; i < impl_->shards.size(); ++i) {
     pool.emplace_back([this, i] {
-      lower_thread_priority(impl_->limits.io_nice);
+      if (!lower_thread_priority(impl_->limits.io_nice)) {
+        spdlog::warn("event=io_nice_denied io_nice={} hint=\"the I/O threads run at the process's priority\"", impl_->limits.io_nice);
+      }
       impl_->shards[i]->run();
     });
   }

@@ -26,7 +26,8 @@ struct ServerLimits {
 
 class HttpServer {
  public:
-  // Binds at once (port 0 picks a free port). Throws std::system_error when the address is taken.
+  // Binds at once (port 0 picks a free port). Throws std::system_error when the address is taken,
+  // std::invalid_argument when limits.io_nice is outside 0..19.
   HttpServer(Router& router, DispatchService& service, ServerLimits limits, const std::string& address,
              unsigned short port, int threads);
   ~HttpServer();

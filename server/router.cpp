@@ -205,6 +205,7 @@ Router::Router(DispatchService& service, TokenAuth auth, RouterConfig config, Cl
         const CongestionResult res = service_.report_congestion(congestion_from_json(parse_body(r.body)), clock_());
         metrics_.observe("congestion_replan_seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
         metrics_.count("replans_total", static_cast<double>(res.missions_replanned));
+        metrics_.count("congestion_missions_repaired_by_reports_total", static_cast<double>(res.missions_repaired_by_reports));
         for (double s : res.mission_replan_s) metrics_.observe("congestion_mission_replan_seconds", s);
         for (double s : res.mission_replan_cpu_s) metrics_.observe("congestion_mission_replan_cpu_seconds", s);
         if (service_.hierarchy() != nullptr) metrics_.observe("congestion_customization_seconds", res.customization_s);

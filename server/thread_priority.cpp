@@ -3,7 +3,6 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
-#include <algorithm>
 #include <cerrno>
 
 namespace corridor::server {
@@ -15,7 +14,7 @@ bool lower_thread_priority(int steps) noexcept {
   errno = 0;
   const int now = getpriority(PRIO_PROCESS, self);
   if (now == -1 && errno != 0) return false;
-  return setpriority(PRIO_PROCESS, self, std::min(19, now + steps)) == 0;
+  return setpriority(PRIO_PROCESS, self, steps >= 19 - now ? 19 : now + steps) == 0;
 }
 
 }  // namespace corridor::server
