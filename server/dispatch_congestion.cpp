@@ -149,13 +149,15 @@ std::vector<DispatchService::MissionPtr> DispatchService::apply_changes(
 
 void DispatchService::repair_one(Mission& m, double now_s, CongestionResult& result,
                                  std::vector<std::shared_ptr<CommitTicket>>& durable) {
+  // The wall clock starts before the mission's lock: a position report holding it (on an I/O
+  // thread, at a lower priority) is part of what the repair waits for.
+  const auto started = std::chrono::steady_clock::now();
   std::lock_guard lock(m.mutex);
   if (m.row.state != MissionState::active) return;
   ++result.missions_replanned;
   const std::vector<EdgeId> before = m.route.edges;
   // The CPU clock is read inside the wall clock's window: a system call is where a pending
   // preemption takes effect, and one just before the window would hide the wait from it.
-  const auto started = std::chrono::steady_clock::now();
   const double cpu_started = thread_cpu_s();
   const std::optional<std::string> reason = repair(m, nullptr);
   const double cpu_s = thread_cpu_s() - cpu_started;

@@ -75,7 +75,7 @@ struct DispatchConfig {
   // served first, with no privilege needed, and the position reports (each of which repairs its
   // own mission, on its I/O thread) and the journal still progress, at nice 10 with a tenth of a
   // worker's share. On 2 cores, Porto, 200 missions, 2,000 positions/s: the batch's repairs within
-  // 2 ms 98.6-98.8 % at 0, 99.6-99.7 % at 10 (docs/routing.md).
+  // 2 ms 98.7-98.9 % at 0, 99.6-99.7 % at 10 (docs/routing.md).
   int background_nice = 10;
   PlannerGraph planner_graph = PlannerGraph::automatic;
   // Arcs per vertex above which `automatic` keeps the turn graph: road networks measure 6 to 10, a
