@@ -118,7 +118,8 @@ struct CongestionResult {
   // From the call's start to the last mission's repaired route: what a dispatcher waits, at most,
   // to see the effect of a congestion report (before its writes are durable).
   double replan_latency_s = 0;
-  // The longest single mission's D* Lite repair in this batch (its own lock held, costs read).
+  // The longest single mission's D* Lite repair in this batch, from before its lock was taken (0
+  // when position reports had repaired every mission first).
   double slowest_replan_s = 0;
   // Each mission's D* Lite repair time, in no particular order: the per-replan latency (the
   // batch's own repairs, not missions_repaired_by_reports).

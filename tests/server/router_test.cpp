@@ -169,7 +169,7 @@ TEST(Router, OnlyRoutesThatWaitForStorageOrPlanningBlock) {
 }
 
 // Every mission repair a congestion report triggers is one sample of the per-replan histogram, so
-// its count matches what the answers said was replanned.
+// without position reports its count matches what the answers said was replanned.
 TEST(Router, CongestionRepairsAreTimedPerMissionInTheMetrics) {
   Rig rig;
   const json m = body(rig.call("POST", "/v1/missions", kDispatcher, mission_body("amb-1")));
@@ -189,6 +189,8 @@ TEST(Router, CongestionRepairsAreTimedPerMissionInTheMetrics) {
             std::string::npos)
       << metrics;
   EXPECT_NE(metrics.find("corridor_replans_total " + std::to_string(replanned) + "\n"), std::string::npos) << metrics;
+  // No position report ran between them, so none repaired a mission first (the bench reads this).
+  EXPECT_NE(metrics.find("\ncorridor_congestion_missions_repaired_by_reports_total 0\n"), std::string::npos) << metrics;
 }
 
 // Per-token token bucket: a burst is allowed, then 429 until time refills it; other tokens are
