@@ -211,6 +211,7 @@ Router::Router(DispatchService& service, TokenAuth auth, RouterConfig config, Cl
         if (service_.hierarchy() != nullptr) metrics_.observe("congestion_customization_seconds", res.customization_s);
         return json_response(200, {{"edges_changed", res.edges_changed},
                                    {"missions_replanned", res.missions_replanned},
+                                   {"missions_repaired_by_reports", res.missions_repaired_by_reports},
                                    {"routes_changed", res.routes_changed},
                                    {"replan_latency_ms", res.replan_latency_s * 1e3},
                                    {"slowest_replan_ms", res.slowest_replan_s * 1e3},

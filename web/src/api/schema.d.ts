@@ -1818,6 +1818,8 @@ export interface components {
             /** @description Customizing the contraction hierarchy shared by all missions to this batch, once, before their repairs; 0 when missions plan on the turn graph */
             customization_ms: number;
             edges_changed: number;
+            /** @description Of missions_replanned, those a position report had already repaired with this batch's changes when the batch reached them; not counted in slowest_replan_ms */
+            missions_repaired_by_reports: number;
             missions_replanned: number;
             replan_latency_ms: number;
             routes_changed: number;
