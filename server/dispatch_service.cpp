@@ -98,6 +98,9 @@ DispatchService::DispatchService(const maps::RoadGraph& graph, std::unordered_ma
   if (config_.max_hierarchy_models < 1) {
     throw std::invalid_argument("max_hierarchy_models must be at least 1, not " + std::to_string(config_.max_hierarchy_models));
   }
+  if (!(std::isfinite(config_.max_clock_ahead_s) && config_.max_clock_ahead_s >= 0.0)) {
+    throw std::invalid_argument("max_clock_ahead_s must be a finite number of seconds >= 0");
+  }
   if (config_.planner_graph != PlannerGraph::turn_graph) {
     // `automatic` must build the topology to know its density, and drops it where it is dense.
     const auto started = std::chrono::steady_clock::now();
@@ -506,7 +509,14 @@ PositionResult DispatchService::report_position(const PositionReport& p, double 
     throw bad_request("speed_mps must be within [0, 150)");
   }
   if (p.hdop && !(std::isfinite(*p.hdop) && *p.hdop >= 0.0)) throw bad_request("hdop must be a number >= 0");
-  if (!std::isfinite(p.timestamp_s)) throw bad_request("timestamp must be a finite number of seconds");
+  if (!(std::isfinite(p.timestamp_s) && p.timestamp_s >= 0.0)) {
+    throw bad_request("timestamp must be a finite number of seconds since the Unix epoch, >= 0");
+  }
+  // A report from the future would make every later one stale (the tracker keeps the newest time).
+  if (p.timestamp_s > now_s + config_.max_clock_ahead_s) {
+    throw bad_request(fmt::format("timestamp is {:g} s ahead of the server's clock; at most {:g} s of skew is taken",
+                                  p.timestamp_s - now_s, config_.max_clock_ahead_s));
+  }
   // Off the map is bad input whatever else the report is: checked before the tracker.
   maps::SnapResult snap;
   try {
@@ -647,6 +657,12 @@ void DispatchService::restore(double now_s) {
     if (c.expires_at_s) expiries_.emplace(*c.expires_at_s, std::make_pair(c.edge, seq));
   }
   Staged staged;
+  // Every vehicle where it last reported, as it reported it (source and speed too), with or
+  // without a mission.
+  for (const PositionRow& last : store_->last_positions()) {
+    vehicles_[last.vehicle_id] = {last.vehicle_id, last.position, last.heading_deg, last.speed_mps,
+                                  last.timestamp_s,  last.source,   std::nullopt};
+  }
   for (MissionRow row : store_->missions(std::nullopt)) {
     next_mission_id_ = std::max(next_mission_id_, row.id + 1);
     if (row.profile != "ambulance" && row.profile != "fire_engine") {
@@ -678,8 +694,6 @@ void DispatchService::restore(double now_s) {
       m->revision = m->history.empty() ? 0 : m->history.back().view.revision;
       missions_[row.id] = m;
       active_by_vehicle_[row.vehicle_id] = row.id;
-      vehicles_[row.vehicle_id] = {row.vehicle_id, start, last ? last->heading_deg : std::nullopt, std::nullopt,
-                                   last ? last->timestamp_s : now_s, "gps", std::nullopt};
       publish_route(*m, "restart", now_s, staged);
       spdlog::info("event=mission_resumed mission={} vehicle={}", row.id, row.vehicle_id);
     } catch (const maps::SnapError& e) {

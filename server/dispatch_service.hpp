@@ -59,6 +59,10 @@ struct DispatchConfig {
   double snap_max_distance_m = 200.0;
   double arrival_radius_m = 30.0;  // closer than this to the destination completes the mission
   double signal_delay_s = 15.0;    // expected delay at a signalized intersection without a plan, for routing
+  // How far a position's timestamp may run ahead of the server's clock (the two clocks' skew). A
+  // report further ahead is refused: taken in, it would make every later report of that vehicle
+  // stale, and the vehicle would stop moving until the server restarted.
+  double max_clock_ahead_s = 300.0;
   // Threads that repair missions' plans after a congestion change, the calling one included
   // (default_repair_threads says how many a server with n I/O threads takes).
   int repair_threads = 2;

@@ -45,6 +45,8 @@ struct PositionRow {
   maps::LatLon position;
   std::optional<double> heading_deg;
   double timestamp_s = 0;
+  std::optional<double> speed_mps;
+  std::string source = "gps";
 };
 
 struct CongestionRow {
@@ -98,6 +100,9 @@ class Store {
 
   [[nodiscard]] std::vector<MissionRow> missions(std::optional<MissionState> state) const;
   [[nodiscard]] std::optional<PositionRow> last_position(const std::string& vehicle_id) const;
+  // Every vehicle's latest followed position, by vehicle id: what GET /v1/vehicles showed before a
+  // restart, missions or not.
+  [[nodiscard]] std::vector<PositionRow> last_positions() const;
   // A mission's route revisions, oldest first.
   [[nodiscard]] std::vector<RouteRevisionView> route_revisions(MissionId mission) const;
   // The latest condition of every edge whose latest update has not expired by `now_s`.

@@ -77,6 +77,50 @@ TEST(DispatchService, PersistsAndResumesActiveMissionsAfterRestart) {
   EXPECT_NEAR(oracle.travel_time_s, resumed.route.travel_time_s, 1e-6);
 }
 
+// GET /v1/vehicles after a restart shows what it showed before: every vehicle that reported, with
+// or without a mission, as it reported (source and speed included).
+TEST(DispatchService, EveryVehiclesLatestPositionSurvivesARestart) {
+  TempDb db;
+  std::vector<VehicleView> before;
+  {
+    Store store(db.path());
+    DispatchService service(grid(), {}, &store, 0.0);
+    const MissionView m = service.create_mission(request("amb-a"), 0.0);
+    PositionReport p;
+    p.vehicle_id = "amb-a";
+    p.position = grid().projection().to_lat_lon(grid().point_along(m.route.edges[1], 1.0));
+    p.timestamp_s = 2.0;
+    p.speed_mps = 9.5;
+    service.report_position(p, 2.0).durable->wait();
+    p.vehicle_id = "free-1";  // no mission
+    p.position = corner(true);
+    p.source = "vo";
+    p.speed_mps = 12.0;
+    p.heading_deg = 90.0;
+    p.timestamp_s = 3.0;
+    service.report_position(p, 3.0).durable->wait();
+    before = service.vehicles();
+  }
+  ASSERT_EQ(before.size(), 2u);
+  Store store(db.path());
+  DispatchService service(grid(), {}, &store, 10.0);
+  const std::vector<VehicleView> after = service.vehicles();
+  ASSERT_EQ(after.size(), before.size());
+  for (std::size_t i = 0; i < after.size(); ++i) {
+    SCOPED_TRACE(after[i].vehicle_id);
+    EXPECT_EQ(after[i].vehicle_id, before[i].vehicle_id);
+    EXPECT_DOUBLE_EQ(after[i].position.lat_deg, before[i].position.lat_deg);
+    EXPECT_DOUBLE_EQ(after[i].position.lon_deg, before[i].position.lon_deg);
+    EXPECT_EQ(after[i].heading_deg, before[i].heading_deg);
+    EXPECT_EQ(after[i].speed_mps, before[i].speed_mps);
+    EXPECT_DOUBLE_EQ(after[i].timestamp_s, before[i].timestamp_s);
+    EXPECT_EQ(after[i].source, before[i].source);
+    EXPECT_EQ(after[i].mission, before[i].mission);
+  }
+  EXPECT_EQ(after[1].source, "vo");
+  EXPECT_EQ(after[1].speed_mps, 12.0);
+}
+
 TEST(Store, MigratesVersion1PositionsToEachVehiclesLatest) {
   TempDb db;
   PositionReport p;

@@ -72,6 +72,17 @@ TEST(DispatchService, RejectsBadRequestsWithStatusCodes) {
   p.position = corner(false);
   p.source = "radar";
   EXPECT_EQ(code_of([&] { service.report_position(p, 0.0); }), 400);
+  p.source = "gps";
+  // A timestamp from the far future would make every later report stale: refused, as is one before
+  // the epoch. Up to max_clock_ahead_s (300 s) of skew is taken.
+  p.timestamp_s = 1e300;
+  EXPECT_EQ(code_of([&] { service.report_position(p, 100.0); }), 400);
+  p.timestamp_s = 100.0 + 301.0;
+  EXPECT_EQ(code_of([&] { service.report_position(p, 100.0); }), 400);
+  p.timestamp_s = -1.0;
+  EXPECT_EQ(code_of([&] { service.report_position(p, 100.0); }), 400);
+  p.timestamp_s = 100.0 + 299.0;
+  EXPECT_EQ(service.report_position(p, 100.0).match.disposition, "followed");
   EXPECT_EQ(code_of([&] { service.report_congestion({}, 0.0); }), 400);
   CongestionUpdate u;
   u.edge = EdgeId{static_cast<std::uint32_t>(grid().edge_count() + 5)};
