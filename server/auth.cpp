@@ -7,6 +7,12 @@ void TokenAuth::add(const std::string& token, Principal principal) {
   if (principal.roles == 0 || (principal.roles & ~kAllRoles) != 0) {
     throw AuthConfigError("token for '" + principal.name + "' needs at least one known role");
   }
+  // A vehicle token reports for its own vehicle only; without a dispatcher's role it must say which.
+  const bool dispatcher = (principal.roles & static_cast<std::uint8_t>(Role::dispatcher)) != 0;
+  const bool vehicle = (principal.roles & static_cast<std::uint8_t>(Role::vehicle)) != 0;
+  if (vehicle && !dispatcher && (!principal.vehicle_id || principal.vehicle_id->empty())) {
+    throw AuthConfigError("token for '" + principal.name + "' has the vehicle role and needs a 'vehicle_id'");
+  }
   tokens_[token] = std::move(principal);
 }
 

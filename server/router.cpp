@@ -77,6 +77,31 @@ json roles_json(std::uint8_t roles) {
   return out;
 }
 
+// A path segment or query value with its %XX escapes decoded (RFC 3986; '+' stays '+'), so that a
+// vehicle id such as "unit 7", sent as "unit%207", names the same vehicle as in the mission's JSON.
+std::string percent_decoded(std::string_view in) {
+  const auto hex = [](char c) -> int {
+    if (c >= '0' && c <= '9') return c - '0';
+    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+    return -1;
+  };
+  std::string out;
+  out.reserve(in.size());
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    if (in[i] != '%') {
+      out.push_back(in[i]);
+      continue;
+    }
+    const int hi = i + 2 < in.size() ? hex(in[i + 1]) : -1;
+    const int lo = hi >= 0 ? hex(in[i + 2]) : -1;
+    if (lo < 0) throw bad_request("malformed percent-encoding in '" + std::string(in.substr(0, 40)) + "'");
+    out.push_back(static_cast<char>(hi * 16 + lo));
+    i += 2;
+  }
+  return out;
+}
+
 // The query of a target ("/v1/x?a=1&b"): {a: "1", b: ""}; a key given twice keeps its last value.
 std::unordered_map<std::string, std::string> parse_query(const std::string& target) {
   std::unordered_map<std::string, std::string> query;
@@ -87,7 +112,7 @@ std::unordered_map<std::string, std::string> parse_query(const std::string& targ
     const std::string_view pair(target.data() + begin, end - begin);
     if (!pair.empty()) {
       const auto eq = pair.find('=');
-      query[std::string(pair.substr(0, eq))] = eq == std::string_view::npos ? "" : std::string(pair.substr(eq + 1));
+      query[percent_decoded(pair.substr(0, eq))] = eq == std::string_view::npos ? "" : percent_decoded(pair.substr(eq + 1));
     }
     begin = end + 1;
   }
@@ -167,8 +192,9 @@ Router::Router(DispatchService& service, TokenAuth auth, RouterConfig config, Cl
   add("POST", "/v1/vehicles/{id}/position", kVehicle | kDispatch, "Report a vehicle position",
       [this](const Principal& who, const Match& m, const HttpRequest& r) {
         const std::string& vehicle = m.params[0];
-        if (!who.has(Role::dispatcher) && who.vehicle_id && *who.vehicle_id != vehicle) {
-          throw ApiError(403, "forbidden", "this token may report positions for vehicle '" + *who.vehicle_id + "' only");
+        if (!who.has(Role::dispatcher) && (!who.vehicle_id || *who.vehicle_id != vehicle)) {
+          throw ApiError(403, "forbidden", who.vehicle_id ? "this token may report positions for vehicle '" + *who.vehicle_id + "' only"
+                                                          : std::string("this token is bound to no vehicle"));
         }
         const auto started = std::chrono::steady_clock::now();
         const PositionReport raw = position_from_json(parse_body(r.body), vehicle);
@@ -284,7 +310,12 @@ bool Router::take_token(const std::string& key, double now_s) {
 }
 
 std::optional<Principal> Router::authorize_stream(const std::string& authorization, const std::string& target) {
-  const auto query = parse_query(target);
+  std::unordered_map<std::string, std::string> query;
+  try {
+    query = parse_query(target);
+  } catch (const ApiError&) {
+    return std::nullopt;  // a malformed query carries no ticket worth trying
+  }
   const auto it = query.find("ticket");
   const std::string ticket = it == query.end() ? std::string() : it->second;
   auto who = ticket.empty() ? auth_.authenticate(authorization) : tickets_.redeem(ticket, clock_());
@@ -338,7 +369,7 @@ const Router::Route* Router::match_route(const std::string& method, std::string_
     if (r.method != method) continue;
     params.clear();
     for (std::size_t i = 0; i < parts.size(); ++i) {
-      if (pattern[i].front() == '{') params.push_back(parts[i]);
+      if (pattern[i].front() == '{') params.push_back(percent_decoded(parts[i]));
     }
     return &r;
   }

@@ -95,6 +95,43 @@ TEST(Router, AuthenticationAndRoles) {
   EXPECT_EQ(rig.call("GET", "/v1/missions", kAmb1).body.find("vehicle-amb1-token"), std::string::npos);
 }
 
+// A vehicle id that needs escaping in a URL ("unit 7" as "unit%207") names the same vehicle as in
+// the mission's JSON; a malformed escape is a 400.
+TEST(Router, PathParametersArePercentDecoded) {
+  Rig rig;
+  const auto created = rig.call("POST", "/v1/missions", kDispatcher, mission_body("unit 7"));
+  ASSERT_EQ(created.status, 201) << created.body;
+  const auto id = body(created)["id"].get<std::uint64_t>();
+  const auto at = grid().projection().to_lat_lon(grid().position(NodeId{0}));
+  const std::string pos = R"({"lat":)" + std::to_string(at.lat_deg) + R"(,"lon":)" + std::to_string(at.lon_deg) +
+                          R"(,"timestamp":1})";
+  const auto reported = rig.call("POST", "/v1/vehicles/unit%207/position", kDispatcher, pos);
+  ASSERT_EQ(reported.status, 200) << reported.body;
+  EXPECT_EQ(body(reported)["mission"], id);
+  const json vehicles = body(rig.call("GET", "/v1/vehicles", kViewer));
+  ASSERT_EQ(vehicles["vehicles"].size(), 1u) << vehicles.dump();
+  EXPECT_EQ(vehicles["vehicles"][0]["vehicle_id"], "unit 7");
+  for (const char* bad : {"/v1/vehicles/unit%2/position", "/v1/vehicles/unit%zz7/position", "/v1/vehicles/%/position"}) {
+    const auto r = rig.call("POST", bad, kDispatcher, pos);
+    EXPECT_EQ(r.status, 400) << bad;
+    EXPECT_EQ(body(r)["error"]["code"], "bad_request") << bad;
+  }
+  EXPECT_EQ(rig.call("GET", "/v1/missions?state=%61ctive", kViewer).status, 200);  // "active"
+}
+
+// A vehicle token without a vehicle id could report for any vehicle: refused when the config is
+// read, not at the first report.
+TEST(Router, AVehicleTokenMustNameItsVehicle) {
+  TokenAuth auth;
+  EXPECT_THROW(auth.add_from_config(json::parse(R"({"tokens":[{"token":"vehicle-no-id-0123456789","name":"amb-9","roles":["vehicle"]}]})")),
+               AuthConfigError);
+  EXPECT_THROW(auth.add_from_config(json::parse(
+                   R"({"tokens":[{"token":"vehicle-no-id-0123456789","name":"amb-9","roles":["vehicle","viewer"],"vehicle_id":""}]})")),
+               AuthConfigError);
+  EXPECT_NO_THROW(auth.add_from_config(json::parse(
+      R"({"tokens":[{"token":"control-room-0123456789","name":"desk","roles":["dispatcher","vehicle"]}]})")));
+}
+
 TEST(Router, BadInputsGetClearFourHundreds) {
   Rig rig;
   const std::pair<std::string, int> cases[] = {
