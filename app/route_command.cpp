@@ -65,6 +65,7 @@ void run_route(const RouteOptions& o) {
   }
   if (o.vmax_kmh && !(*o.vmax_kmh > 0.0 && *o.vmax_kmh <= 400.0)) throw UsageError("--vmax-kmh must be in (0, 400]");
   if (!(o.signal_delay_s >= 0.0 && o.signal_delay_s < 3600.0)) throw UsageError("--signal-delay-s must be in [0, 3600)");
+  if (!(o.max_snap_m > 0.0 && o.max_snap_m <= 100000.0)) throw UsageError("--max-snap-m must be in (0, 100000] metres");
   if (o.signals != "flat" && o.signals != "preempted" && o.signals != "normal") {
     throw UsageError("--signals must be flat, preempted or normal, got '" + o.signals + "'");
   }

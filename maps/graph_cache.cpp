@@ -155,11 +155,21 @@ void write_graph_cache(const std::filesystem::path& file, const RoadGraph& graph
     const std::uint64_t sum = w.checksum();
     out.write(reinterpret_cast<const char*>(&sum), sizeof sum);
     out.flush();
-    if (!out) throw GraphCacheError("failed writing graph cache '" + tmp.string() + "'");
+    if (!out) {
+      out.close();
+      std::error_code ignored;
+      std::filesystem::remove(tmp, ignored);
+      throw GraphCacheError("failed writing graph cache '" + tmp.string() + "'");
+    }
   }
   std::error_code ec;
   std::filesystem::rename(tmp, file, ec);
-  if (ec) throw GraphCacheError("cannot move graph cache into place at '" + file.string() + "': " + ec.message());
+  if (ec) {
+    // A half-placed cache is no use to anyone: leave nothing behind but the error.
+    std::error_code ignored;
+    std::filesystem::remove(tmp, ignored);
+    throw GraphCacheError("cannot move graph cache into place at '" + file.string() + "': " + ec.message());
+  }
 }
 
 bool looks_like_graph_cache(const std::filesystem::path& file) {

@@ -62,7 +62,15 @@ RoadGraph load_map(const std::filesystem::path& file, const MapLoadOptions& opti
   if (looks_like_graph_cache(file)) {
     local.origin = MapLoadInfo::Origin::cache;
     local.cache_file = file;
-    return finish(read_graph_cache(file));
+    RoadGraph graph = read_graph_cache(file);
+    // The side of the road was fixed when the cache was imported; a request for the other side
+    // must not pass unnoticed with the first side's turn costs.
+    if (options.import.left_hand_traffic && !graph.left_hand_traffic()) {
+      throw MapLoadError("'" + file.string() +
+                         "' is a graph cache imported for right-hand traffic; the side of the road is chosen on import "
+                         "(corridor map import --left-hand-traffic), or pass the OSM file itself");
+    }
+    return finish(std::move(graph));
   }
 
   const CacheSource source = describe_source(file);

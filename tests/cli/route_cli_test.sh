@@ -111,6 +111,8 @@ expect_error "not a valid coordinate" "$corridor" route --from 95,7.42 --to 43.7
 expect_error "no drivable road within" "$corridor" route --from 43.7300,7.4300 --to 43.7496,7.4365 --max-snap-m 20
 expect_error "--algo must be" "$corridor" route --from 43.7384,7.4246 --to 43.7496,7.4365 --algo bfs
 expect_error "--vmax-kmh" "$corridor" route --from 43.7384,7.4246 --to 43.7496,7.4365 --vmax-kmh -3
+expect_error "--max-snap-m must be" "$corridor" route --from 43.7384,7.4246 --to 43.7496,7.4365 --max-snap-m nan
+expect_error "--max-snap-m must be" "$corridor" route --from 43.7384,7.4246 --to 43.7496,7.4365 --max-snap-m -1
 
 # 4. The cache: a second load comes from it, and a graph cache works as --map.
 "$corridor" map info --map "$data/monaco.osm.gz" > "$work/info1.json"

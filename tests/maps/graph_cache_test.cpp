@@ -184,6 +184,32 @@ TEST(MapLoader, ImportsOnceThenReusesTheCacheUntilTheSourceChanges) {
   EXPECT_EQ(direct.node_count(), 3u);
 }
 
+// The side of the road is fixed when a cache is imported: asking a right-hand cache for left-hand
+// traffic is an error, not a silent answer with the other side's turn costs.
+TEST(MapLoader, ACacheKeepsTheSideOfTheRoadItWasImportedFor) {
+  TempDir dir;
+  const auto right = dir.path() / "right.cgr";
+  write_graph_cache(right, small_grid(), {});
+  MapLoadOptions left;
+  left.import.left_hand_traffic = true;
+  EXPECT_THROW((void)load_map(right, left), MapLoadError);
+  EXPECT_FALSE(load_map(right, {}).left_hand_traffic());
+  RoadGraphData d = small_grid().data();
+  d.left_hand_traffic = {1};
+  const auto lht = dir.path() / "left.cgr";
+  write_graph_cache(lht, RoadGraph(std::move(d)), {});
+  EXPECT_TRUE(load_map(lht, left).left_hand_traffic());
+}
+
+// A cache that cannot be put in place leaves no half-written file behind.
+TEST(GraphCache, AFailedWriteLeavesNoTemporaryFile) {
+  TempDir dir;
+  const auto target = dir.path() / "taken";
+  std::filesystem::create_directories(target / "inside");  // a non-empty directory: rename fails
+  EXPECT_THROW(write_graph_cache(target, small_grid(), {}), GraphCacheError);
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "taken.tmp"));
+}
+
 TEST(MapLoader, MissingMapIsAClearError) {
   EXPECT_THROW((void)load_map("/no/such/map.osm.pbf", {}), MapLoadError);
 }
