@@ -1,5 +1,6 @@
 #include "app/serve_command.hpp"
 
+#include <boost/asio/ip/address.hpp>
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
@@ -52,6 +53,37 @@ nlohmann::json read_config(const std::string& path) {
   return j;
 }
 
+// One number of the config's "limits", within [lo, hi]; a usage error that names the field otherwise.
+double limit_in(const nlohmann::json& limits, const char* key, double fallback, double lo, double hi) {
+  const auto it = limits.find(key);
+  if (it == limits.end()) return fallback;
+  if (!it->is_number()) throw UsageError(fmt::format("config: limits.{} must be a number", key));
+  const double v = it->get<double>();
+  if (!(v >= lo && v <= hi)) throw UsageError(fmt::format("config: limits.{} must be within [{}, {}], got {}", key, lo, hi, v));
+  return v;
+}
+
+void read_limits(const nlohmann::json& config, server::RouterConfig& router, server::ServerLimits& limits) {
+  const auto it = config.find("limits");
+  if (it == config.end()) return;
+  if (!it->is_object()) throw UsageError("config: 'limits' must be an object");
+  for (const auto& [key, value] : it->items()) {
+    if (key != "rate_per_token_per_s" && key != "burst_per_token" && key != "body_limit_bytes" &&
+        key != "header_limit_bytes" && key != "read_timeout_s") {
+      throw UsageError("config: unknown limit '" + key +
+                       "' (known: rate_per_token_per_s, burst_per_token, body_limit_bytes, header_limit_bytes, read_timeout_s)");
+    }
+  }
+  router.rate_per_token_per_s = limit_in(*it, "rate_per_token_per_s", router.rate_per_token_per_s, 1e-3, 1e9);
+  router.burst_per_token = limit_in(*it, "burst_per_token", router.burst_per_token, 1.0, 1e9);
+  // Integers where the server counts bytes and seconds: a fraction is rounded down.
+  limits.body_limit_bytes = static_cast<std::size_t>(
+      limit_in(*it, "body_limit_bytes", static_cast<double>(limits.body_limit_bytes), 1024.0, 1024.0 * 1024 * 1024));
+  limits.header_limit_bytes = static_cast<std::size_t>(
+      limit_in(*it, "header_limit_bytes", static_cast<double>(limits.header_limit_bytes), 1024.0, 1024.0 * 1024));
+  limits.read_timeout_s = static_cast<int>(limit_in(*it, "read_timeout_s", limits.read_timeout_s, 1.0, 3600.0));
+}
+
 void run_serve(const ServeOptions& o) {
   const auto colon = o.listen.rfind(':');
   if (colon == std::string::npos) throw UsageError("--listen expects HOST:PORT, got '" + o.listen + "'");
@@ -62,6 +94,11 @@ void run_serve(const ServeOptions& o) {
   } catch (const std::exception&) {
   }
   if (port < 0 || port > 65535) throw UsageError("--listen port must be 0..65535, got '" + o.listen.substr(colon + 1) + "'");
+  {
+    boost::system::error_code ec;
+    (void)boost::asio::ip::make_address(host, ec);
+    if (ec) throw UsageError("--listen host must be an IP address (for example 127.0.0.1 or ::1), got '" + host + "'");
+  }
   if (o.threads < 1 || o.threads > 64) throw UsageError("--threads must be 1..64");
   const nlohmann::json config = read_config(o.config);
 
@@ -78,13 +115,7 @@ void run_serve(const ServeOptions& o) {
   }
   server::RouterConfig router_config;
   server::ServerLimits limits;
-  if (auto it = config.find("limits"); it != config.end() && it->is_object()) {
-    router_config.rate_per_token_per_s = it->value("rate_per_token_per_s", router_config.rate_per_token_per_s);
-    router_config.burst_per_token = it->value("burst_per_token", router_config.burst_per_token);
-    limits.body_limit_bytes = it->value("body_limit_bytes", limits.body_limit_bytes);
-    limits.header_limit_bytes = it->value("header_limit_bytes", limits.header_limit_bytes);
-    limits.read_timeout_s = it->value("read_timeout_s", limits.read_timeout_s);
-  }
+  read_limits(config, router_config, limits);
 
   const maps::RoadGraph graph = load_map_from_options(o.map);
   server::Store store(o.db);
