@@ -1,5 +1,6 @@
 #include "app/localize_command.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -161,7 +162,12 @@ void run_localize(const LocalizeOptions& o) {
   std::size_t gi = 0, oi = 0;
   std::unique_ptr<sim::CorridorClient> client;
   if (!o.server.empty()) client = std::make_unique<sim::CorridorClient>(o.server, o.token);
-  const double epoch = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+  // The sequence's times as Unix seconds, keeping its intervals (the tracker reads speeds from them).
+  // Posted `speedup` times faster than real time, they would run ahead of the wall clock, and the
+  // server refuses positions from further ahead than its clock skew allows: so the sequence is
+  // placed early enough that its last report is due when it is sent.
+  const double epoch = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count() -
+                       std::max(0.0, t_end - t_begin) * std::max(0.0, 1.0 - 1.0 / o.speedup);
   const auto wall_start = std::chrono::steady_clock::now();
   json points = json::array();
   std::size_t posted_gps = 0, posted_vo = 0, completed_at = 0;

@@ -314,7 +314,7 @@ std::optional<Principal> Router::authorize_stream(const std::string& authorizati
   try {
     query = parse_query(target);
   } catch (const ApiError&) {
-    return std::nullopt;  // a malformed query carries no ticket worth trying
+    query.clear();  // a malformed query carries no ticket: the Authorization header may still hold
   }
   const auto it = query.find("ticket");
   const std::string ticket = it == query.end() ? std::string() : it->second;
@@ -384,7 +384,7 @@ bool Router::blocks(const HttpRequest& request) const noexcept {
     const Route* r = match_route(request.method, target.substr(0, target.find('?')), params, path_known);
     return r != nullptr && r->blocking;
   } catch (...) {
-    return false;  // out of memory: answer() will say so
+    return false;  // a malformed path, or out of memory: answer() will say so
   }
 }
 
@@ -394,8 +394,7 @@ HttpResponse Router::answer(const HttpRequest& request, std::string& route_name)
     const auto q = request.target.find('?');
     const std::string path = request.target.substr(0, q);
     Match match;
-    match.query = parse_query(request.target);
-    // Outside the API: the console's files (GET and HEAD only).
+    // Outside the API: the console's files (GET and HEAD only), whatever their query holds.
     if (site_ && path.rfind("/v1/", 0) != 0 && path != "/v1" && path != "/metrics") {
       route_name = "GET /";
       if (request.method != "GET" && request.method != "HEAD") {
@@ -405,6 +404,7 @@ HttpResponse Router::answer(const HttpRequest& request, std::string& route_name)
       if (r.status != 200) throw ApiError(r.status, r.error_code, r.error_message);
       return HttpResponse{200, std::move(r.content_type), std::string(r.body), nullptr, std::move(r.headers)};
     }
+    match.query = parse_query(request.target);
     bool path_known = false;
     const Route* found = match_route(request.method, path, match.params, path_known);
     if (found == nullptr) {

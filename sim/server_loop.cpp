@@ -101,7 +101,9 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
     const double due = wall_start + (t - begin_s);
     if (const double wait = due - wall_s(); wait > 0) std::this_thread::sleep_for(std::chrono::duration<double>(wait));
     t = bridge.step();
-    const double now = wall_start + t;
+    // The same clock as `due`: a scenario that begins at 07:00 is not seven hours ahead of the
+    // server's, which refuses positions from further ahead than its clock skew allows.
+    const double now = wall_start + (t - begin_s);
     const auto sim = libtraci::Simulation::getSubscriptionResults();
     result.collisions += static_cast<int>(as_double(sim, libsumo::VAR_COLLIDING_VEHICLES_NUMBER));
     result.teleports += static_cast<int>(as_double(sim, libsumo::VAR_TELEPORT_STARTING_VEHICLES_NUMBER));

@@ -86,6 +86,9 @@ TEST(ConsoleApi, StreamTicketIsSingleUseAndShortLived) {
   // A bad ticket is not rescued by a good header, and the header still works alone.
   EXPECT_FALSE(rig.router.authorize_stream(kViewer, "/v1/stream?ticket=nope").has_value());
   EXPECT_TRUE(rig.router.authorize_stream(kViewer, "/v1/stream").has_value());
+  // A malformed query carries no ticket, but the header still counts.
+  EXPECT_TRUE(rig.router.authorize_stream(kViewer, "/v1/stream?mission=%zz").has_value());
+  EXPECT_FALSE(rig.router.authorize_stream("", "/v1/stream?ticket=%zz").has_value());
 }
 
 TEST(StreamTickets, ManyOutstandingTicketsStayBounded) {
@@ -231,6 +234,8 @@ TEST(ConsoleApi, SignalStateFollowsItsPreemption) {
 
 TEST(ConsoleSite, ServesTheAppWithTypesCachingAndPolicy) {
   Rig rig;
+  // The console's page, whatever its query holds (the API's percent-decoding is not the site's).
+  EXPECT_EQ(rig.call("GET", "/?x=%zz").status, 200);
   const auto index = rig.call("GET", "/");
   ASSERT_EQ(index.status, 200);
   EXPECT_EQ(index.body, kIndex);
