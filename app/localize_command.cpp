@@ -217,7 +217,7 @@ void run_localize(const LocalizeOptions& o) {
       json body{{"lat", p.position.lat_deg}, {"lon", p.position.lon_deg}, {"heading_deg", p.heading_deg},
                 {"timestamp", epoch + (t - t_begin)}, {"source", p.source == localizer::PositionSource::gps ? "gps" : "vo"}};
       if (p.source == localizer::PositionSource::gps && hdop) body["hdop"] = *hdop;
-      const json answer = client->post("/v1/vehicles/" + o.vehicle + "/position", body);
+      const json answer = client->post("/v1/vehicles/" + sim::path_segment(o.vehicle) + "/position", body);
       (p.source == localizer::PositionSource::gps ? posted_gps : posted_vo) += 1;
       if (!completed && answer.value("completed", false)) {
         completed = true;

@@ -6,8 +6,14 @@
 
 #include <memory>
 #include <string>
+#include <string_view>
 
 namespace corridor::sim {
+
+// `text` as one segment of a URL path: every byte but RFC 3986's unreserved ones
+// (A-Z a-z 0-9 - . _ ~) percent-encoded, so that an id such as "unit 7" or "a/b" names that id
+// on the server (which decodes it) and not another path.
+std::string path_segment(std::string_view text);
 
 class CorridorClient {
  public:

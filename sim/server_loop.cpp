@@ -144,7 +144,7 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
       const EdgeId first = starts.front().edge;
       const maps::Point2 a = g.point_along(first, 1.0), b = g.point_along(first, 6.0);
       const double heading = std::fmod(std::atan2(b.x_m - a.x_m, b.y_m - a.y_m) * 180.0 / M_PI + 360.0, 360.0);
-      server.post("/v1/vehicles/" + vehicle + "/position", position_json(g, a, heading, 0.0, now));
+      server.post("/v1/vehicles/" + path_segment(vehicle) + "/position", position_json(g, a, heading, 0.0, now));
       const maps::LatLon dest = g.projection().to_lat_lon(g.point_along(goals.front().edge, g.length_m(goals.front().edge) - 1.0));
       const json m = server.post("/v1/missions", {{"vehicle_id", vehicle},
                                                   {"destination", {{"lat", dest.lat_deg}, {"lon", dest.lon_deg}}},
@@ -213,7 +213,7 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
             } else {
               // The bad fix is reported honestly (the server stores it as low_accuracy) and the
               // onboard odometry's position follows as source "vo".
-              (void)server.post("/v1/vehicles/" + vehicle + "/position", fix);
+              (void)server.post("/v1/vehicles/" + path_segment(vehicle) + "/position", fix);
               const localizer::LocalizedPoint& p = onboard.last();
               if (p.source == localizer::PositionSource::odometry) {
                 json vo = position_json(g, p.match.point, p.heading_deg, as_double(ev, libsumo::VAR_SPEED), now + 1e-3);
@@ -226,7 +226,7 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
           report = position_json(g, {pos->x, pos->y}, as_double(ev, libsumo::VAR_ANGLE), as_double(ev, libsumo::VAR_SPEED), now);
         }
         if (report) {
-          const json res = server.post("/v1/vehicles/" + vehicle + "/position", *report);
+          const json res = server.post("/v1/vehicles/" + path_segment(vehicle) + "/position", *report);
           if (res.value("route_changed", false) && mission) {
             const auto fresh = sumo_route_of(sg, server.get("/v1/missions/" + std::to_string(*mission)));
             if (!fresh.empty() && fresh.front() == road && fresh != route) {
