@@ -192,9 +192,9 @@ Router::Router(DispatchService& service, TokenAuth auth, RouterConfig config, Cl
   add("POST", "/v1/vehicles/{id}/position", kVehicle | kDispatch, "Report a vehicle position",
       [this](const Principal& who, const Match& m, const HttpRequest& r) {
         const std::string& vehicle = m.params[0];
-        if (!who.has(Role::dispatcher) && (!who.vehicle_id || *who.vehicle_id != vehicle)) {
-          throw ApiError(403, "forbidden", who.vehicle_id ? "this token may report positions for vehicle '" + *who.vehicle_id + "' only"
-                                                          : std::string("this token is bound to no vehicle"));
+        // TokenAuth gives every vehicle token without the dispatcher role its vehicle_id.
+        if (!who.has(Role::dispatcher) && who.vehicle_id != vehicle) {
+          throw ApiError(403, "forbidden", "this token may report positions for vehicle '" + who.vehicle_id.value_or("") + "' only");
         }
         const auto started = std::chrono::steady_clock::now();
         const PositionReport raw = position_from_json(parse_body(r.body), vehicle);

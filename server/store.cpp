@@ -438,23 +438,32 @@ std::vector<RouteRevisionView> Store::route_revisions(MissionId mission) const {
   return out;
 }
 
+namespace {
+
+// Each vehicle's latest followed position, one row per vehicle, read by position_row().
+constexpr const char* kLastPositions =
+    "SELECT v.vehicle_id, p.lat, p.lon, p.heading_deg, p.timestamp_s, p.speed_mps, p.source FROM "
+    "vehicle_last_position v JOIN positions p ON p.id = v.position_id";
+
+PositionRow position_row(const Statement& s) {
+  return {s.text(0), {s.real(1), s.real(2)}, s.optional_real(3), s.real(4), s.optional_real(5), s.text(6)};
+}
+
+}  // namespace
+
 std::optional<PositionRow> Store::last_position(const std::string& vehicle_id) const {
-  Statement s(db_,
-              "SELECT p.lat, p.lon, p.heading_deg, p.timestamp_s, p.speed_mps, p.source FROM vehicle_last_position v "
-              "JOIN positions p ON p.id = v.position_id WHERE v.vehicle_id = ?");
+  const std::string sql = std::string(kLastPositions) + " WHERE v.vehicle_id = ?";
+  Statement s(db_, sql.c_str());
   s.bind(1, vehicle_id);
   if (!s.step()) return std::nullopt;
-  return PositionRow{vehicle_id, {s.real(0), s.real(1)}, s.optional_real(2), s.real(3), s.optional_real(4), s.text(5)};
+  return position_row(s);
 }
 
 std::vector<PositionRow> Store::last_positions() const {
-  Statement s(db_,
-              "SELECT v.vehicle_id, p.lat, p.lon, p.heading_deg, p.timestamp_s, p.speed_mps, p.source FROM "
-              "vehicle_last_position v JOIN positions p ON p.id = v.position_id ORDER BY v.vehicle_id");
+  const std::string sql = std::string(kLastPositions) + " ORDER BY v.vehicle_id";
+  Statement s(db_, sql.c_str());
   std::vector<PositionRow> out;
-  while (s.step()) {
-    out.push_back({s.text(0), {s.real(1), s.real(2)}, s.optional_real(3), s.real(4), s.optional_real(5), s.text(6)});
-  }
+  while (s.step()) out.push_back(position_row(s));
   return out;
 }
 
