@@ -3,13 +3,22 @@
 #include <algorithm>
 #include <map>
 #include <numeric>
+#include <optional>
 
 #include "maps/errors.hpp"
 
 namespace corridor::maps {
 namespace {
 
-bool drivable(const SumoEdge& e) { return (e.function.empty() || e.function == "normal") && !e.lanes.empty(); }
+bool drivable(const SumoEdge& e, SumoClasses cls) { return (e.function.empty() || e.function == "normal") && e.admits(cls); }
+
+// The lane whose length, speed and shape stand for the edge: the first the class may use.
+const SumoLane& lane_for(const SumoEdge& e, SumoClasses cls) {
+  for (const SumoLane& l : e.lanes) {
+    if ((l.allowed & cls) != 0) return l;
+  }
+  return e.lanes.front();
+}
 
 struct Arc {
   NodeId tail;
@@ -25,12 +34,16 @@ std::span<const EdgeId> SumoGraph::arcs(const std::string& sumo_edge) const {
   return it->second;
 }
 
-SumoGraph build_sumo_graph(const SumoNet& net) {
+SumoGraph build_sumo_graph(const SumoNet& net, std::string_view vehicle_class) {
+  const std::optional<SumoClasses> cls = sumo_class_bit(vehicle_class);
+  if (!cls) throw MapLoadError("'" + std::string(vehicle_class) + "' is not a SUMO vehicle class (for example emergency, passenger, bus)");
   std::vector<const SumoEdge*> edges;
   for (const SumoEdge& e : net.edges) {
-    if (drivable(e)) edges.push_back(&e);
+    if (drivable(e, *cls)) edges.push_back(&e);
   }
-  if (edges.empty()) throw MapLoadError("the SUMO network has no normal edge to drive on");
+  if (edges.empty()) {
+    throw MapLoadError("the SUMO network has no normal edge a vehicle of class '" + std::string(vehicle_class) + "' may drive on");
+  }
 
   RoadGraphData d;
   d.origin = {0.0, 0.0};  // the net's own metric frame; SUMO runs need no geographic position
@@ -47,7 +60,7 @@ SumoGraph build_sumo_graph(const SumoNet& net) {
     return v;
   };
   for (const SumoEdge* e : edges) {
-    const auto& shape = e->lanes.front().shape;
+    const auto& shape = lane_for(*e, *cls).shape;
     const Point2 end = shape.empty() ? Point2{} : shape.back();
     stop_line.emplace(e->id, add_node(*e, end));
   }
@@ -59,13 +72,14 @@ SumoGraph build_sumo_graph(const SumoNet& net) {
     const auto from = stop_line.find(c.from);
     const auto to = stop_line.find(c.to);
     if (from == stop_line.end() || to == stop_line.end()) continue;  // internal or non-drivable edges
+    if (!net.admits(c, *cls)) continue;  // a lane or a turn this class may not take
     if (!seen.emplace(std::make_pair(c.from, c.to), true).second) continue;
     arcs.push_back({from->second, to->second, net.edge(c.to)});
     has_predecessor[c.to] = true;
   }
   for (const SumoEdge* e : edges) {
     if (has_predecessor.contains(e->id)) continue;
-    const auto& shape = e->lanes.front().shape;
+    const auto& shape = lane_for(*e, *cls).shape;
     const NodeId entry = add_node(*e, shape.empty() ? Point2{} : shape.front());
     d.node_signalized.back() = 0;
     arcs.push_back({entry, stop_line.at(e->id), e});
@@ -83,14 +97,17 @@ SumoGraph build_sumo_graph(const SumoNet& net) {
     d.edge_tail.push_back(a.tail);
     d.edge_head.push_back(a.head);
     double speed = 0.0;
-    for (const SumoLane& l : a.onto->lanes) speed = std::max(speed, l.speed_mps);
-    d.edge_length_m.push_back(std::max(0.1, a.onto->lanes.front().length_m));
+    for (const SumoLane& l : a.onto->lanes) {
+      if ((l.allowed & *cls) != 0) speed = std::max(speed, l.speed_mps);
+    }
+    const SumoLane& lane = lane_for(*a.onto, *cls);
+    d.edge_length_m.push_back(std::max(0.1, lane.length_m));
     d.edge_speed_mps.push_back(static_cast<float>(std::max(speed, 0.1)));
     d.edge_osm_way.push_back(OsmWayId{static_cast<std::int64_t>(id.v + 1)});
     d.edge_class.push_back(RoadClass::primary);
     // From the previous stop line over the junction onto the edge, to its own stop line.
     d.geometry.push_back({d.node_x_m[a.tail.index()], d.node_y_m[a.tail.index()]});
-    for (const Point2& p : a.onto->lanes.front().shape) d.geometry.push_back(p);
+    for (const Point2& p : lane.shape) d.geometry.push_back(p);
     if (d.geometry.size() - d.geometry_first.back() < 2) d.geometry.push_back({d.node_x_m[a.head.index()], d.node_y_m[a.head.index()]});
     d.geometry_first.push_back(static_cast<std::uint32_t>(d.geometry.size()));
     by_ends.emplace(std::make_pair(a.tail, a.head), id);
@@ -105,7 +122,7 @@ SumoGraph build_sumo_graph(const SumoNet& net) {
   }
   build_reverse_adjacency(d);
   d.turns_in_edges = {1};  // a graph edge is a SUMO connection: every turn in the graph is one SUMO allows
-  return SumoGraph{RoadGraph(std::move(d)), std::move(sumo_edge_of_arc), std::move(node_edge), std::move(arcs_onto),
+  return SumoGraph{RoadGraph(std::move(d)), *cls, std::move(sumo_edge_of_arc), std::move(node_edge), std::move(arcs_onto),
                    std::move(stop_line)};
 }
 

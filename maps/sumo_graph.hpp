@@ -1,12 +1,15 @@
-// A SUMO network as an edge-based RoadGraph, so that SUMO's turn rules hold in every route: each
-// SUMO edge's stop line is a graph node, and each SUMO connection (from edge -> to edge) is a graph
-// edge that drives the whole `to` edge. A U-turn or a turn SUMO does not connect is simply not in
-// the graph. SUMO edges that nothing leads into get an extra entry node at their start.
+// A SUMO network as an edge-based RoadGraph for one vehicle class, so that SUMO's turn rules and
+// lane permissions hold in every route: each SUMO edge the class may use has its stop line as a
+// graph node, and each SUMO connection (from edge -> to edge) whose lanes admit the class is a graph
+// edge that drives the whole `to` edge. A U-turn, a turn SUMO does not connect, a bus-only lane or
+// a connection only other classes may take is simply not in the graph. SUMO edges that nothing
+// leads into get an extra entry node at their start.
 #pragma once
 
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <unordered_map>
 #include <vector>
 
@@ -17,6 +20,7 @@ namespace corridor::maps {
 
 struct SumoGraph {
   RoadGraph graph;
+  SumoClasses vehicle_class = kAllSumoClasses;  // the class the graph was built for
   std::vector<std::string> sumo_edge_of_arc;                     // by EdgeId: the SUMO edge it drives
   std::vector<std::string> sumo_edge_of_node;                    // by NodeId: whose stop line (or entry) it is
   std::unordered_map<std::string, std::vector<EdgeId>> arcs_onto;  // SUMO edge -> the graph edges driving it
@@ -26,8 +30,10 @@ struct SumoGraph {
   [[nodiscard]] std::span<const EdgeId> arcs(const std::string& sumo_edge) const;
 };
 
-// Throws MapLoadError when the net has no drivable edge or a connection names an unknown edge.
-SumoGraph build_sumo_graph(const SumoNet& net);
+// The graph for vehicles of SUMO class `vehicle_class` ("emergency" unless the run's vehicle type
+// says otherwise). Length, speed and shape come from the first lane the class may use. Throws
+// MapLoadError for an unknown class, or when the class can drive no edge of the net.
+SumoGraph build_sumo_graph(const SumoNet& net, std::string_view vehicle_class = "emergency");
 
 // The traffic lights as signal plans keyed by graph node: every stop line a light controls gets
 // that light's plan, with each movement (SUMO link) tied to the graph edge of its connection.

@@ -63,7 +63,8 @@ void on_start(void* user, const char* name, const char** attrs) {
   if (std::strcmp(name, "edge") == 0) {
     net.edges.push_back({a.str("id"), a.str("from"), a.str("to"), a.str("function"), {}});
   } else if (std::strcmp(name, "lane") == 0 && !net.edges.empty()) {
-    net.edges.back().lanes.push_back({a.str("id"), a.number("length"), a.number("speed"), parse_shape(a.str("shape"))});
+    net.edges.back().lanes.push_back({a.str("id"), a.number("length"), a.number("speed"), parse_shape(a.str("shape")),
+                                      parse_sumo_permissions(a.str("allow"), a.str("disallow"))});
   } else if (std::strcmp(name, "junction") == 0) {
     net.junctions.push_back({a.str("id"), a.str("type"), {a.number("x"), a.number("y")}, {}});
   } else if (std::strcmp(name, "request") == 0 && !net.junctions.empty()) {
@@ -86,6 +87,7 @@ void on_start(void* user, const char* name, const char** attrs) {
     c.link_index = static_cast<int>(a.number("linkIndex", -1));
     const std::string dir = a.str("dir");
     c.dir = dir.empty() ? 's' : dir[0];
+    if (a.get("allow") != nullptr || a.get("disallow") != nullptr) c.allowed = parse_sumo_permissions(a.str("allow"), a.str("disallow"));
     net.connections.push_back(std::move(c));
   } else if (std::strcmp(name, "tlLogic") == 0) {
     net.tl_logics.push_back({a.str("id"), a.str("programID"), a.str("type"), {}});
@@ -134,6 +136,10 @@ Turn turn_of(char dir) {
 }  // namespace
 
 const SumoEdge* SumoNet::edge(const std::string& id) const {
+  if (!edge_index.empty()) {
+    const auto it = edge_index.find(id);
+    return it == edge_index.end() ? nullptr : &edges[it->second];
+  }
   for (const auto& e : edges) {
     if (e.id == id) return &e;
   }
@@ -141,10 +147,51 @@ const SumoEdge* SumoNet::edge(const std::string& id) const {
 }
 
 const SumoJunction* SumoNet::junction(const std::string& id) const {
+  if (!junction_index.empty()) {
+    const auto it = junction_index.find(id);
+    return it == junction_index.end() ? nullptr : &junctions[it->second];
+  }
   for (const auto& j : junctions) {
     if (j.id == id) return &j;
   }
   return nullptr;
+}
+
+const SumoLane* SumoNet::lane(const std::string& id) const {
+  if (!lane_index.empty()) {
+    const auto it = lane_index.find(id);
+    return it == lane_index.end() ? nullptr : &edges[it->second.first].lanes[it->second.second];
+  }
+  for (const auto& e : edges) {
+    for (const auto& l : e.lanes) {
+      if (l.id == id) return &l;
+    }
+  }
+  return nullptr;
+}
+
+bool SumoNet::admits(const SumoConnection& c, SumoClasses cls) const {
+  if (c.allowed) return (*c.allowed & cls) != 0;
+  const auto lane_admits = [&](const std::string& edge_id, int index) {
+    const SumoEdge* e = edge(edge_id);
+    if (e == nullptr || index < 0 || static_cast<std::size_t>(index) >= e->lanes.size()) return false;
+    return (e->lanes[static_cast<std::size_t>(index)].allowed & cls) != 0;
+  };
+  if (!lane_admits(c.from, c.from_lane) || !lane_admits(c.to, c.to_lane)) return false;
+  // The internal lane carries the connection's own permissions where netconvert set them.
+  if (const SumoLane* via = c.via.empty() ? nullptr : lane(c.via)) return (via->allowed & cls) != 0;
+  return true;
+}
+
+void SumoNet::build_index() {
+  edge_index.clear();
+  junction_index.clear();
+  lane_index.clear();
+  for (std::size_t i = 0; i < edges.size(); ++i) {
+    edge_index.emplace(edges[i].id, i);
+    for (std::size_t k = 0; k < edges[i].lanes.size(); ++k) lane_index.emplace(edges[i].lanes[k].id, std::pair(i, k));
+  }
+  for (std::size_t i = 0; i < junctions.size(); ++i) junction_index.emplace(junctions[i].id, i);
 }
 
 namespace {
@@ -183,6 +230,7 @@ SumoNet read_sumo_net(const std::filesystem::path& file) {
   ParseState st;
   parse_sumo_xml(file, "SUMO network", st);
   if (st.net.edges.empty()) throw MapLoadError("'" + file.string() + "' holds no SUMO edges: is it a .net.xml?");
+  st.net.build_index();
   return std::move(st.net);
 }
 

@@ -4,11 +4,14 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "maps/geo.hpp"
 #include "maps/signal_plan.hpp"
+#include "maps/sumo_vehicle_class.hpp"
 
 namespace corridor::maps {
 
@@ -17,6 +20,7 @@ struct SumoLane {
   double length_m = 0;
   double speed_mps = 0;
   std::vector<Point2> shape;  // SUMO's network coordinates
+  SumoClasses allowed = kAllSumoClasses;  // its allow / disallow
 };
 
 struct SumoEdge {
@@ -25,6 +29,13 @@ struct SumoEdge {
   std::string to;
   std::string function;  // "internal" for junction-internal edges
   std::vector<SumoLane> lanes;
+
+  [[nodiscard]] bool admits(SumoClasses cls) const {
+    for (const SumoLane& l : lanes) {
+      if ((l.allowed & cls) != 0) return true;
+    }
+    return false;
+  }
 };
 
 struct SumoRequest {
@@ -48,6 +59,8 @@ struct SumoConnection {
   std::string tl;
   int link_index = -1;
   char dir = 's';
+  // A connection's own allow / disallow (a plain connection file's), which overrides its lanes'.
+  std::optional<SumoClasses> allowed;
 };
 
 struct SumoTlPhase {
@@ -72,8 +85,21 @@ struct SumoNet {
   std::string proj_parameter;
   std::string version;  // <net version="1.9">: the netconvert release that wrote the file
 
+  // Lookups by id, from the index read_sumo_net builds (a linear scan before it is built).
   [[nodiscard]] const SumoEdge* edge(const std::string& id) const;
   [[nodiscard]] const SumoJunction* junction(const std::string& id) const;
+  // Any lane, internal ones included, by its id; null when there is none.
+  [[nodiscard]] const SumoLane* lane(const std::string& id) const;
+  // Whether a vehicle of class `cls` may take the connection: its from and to lanes, and the
+  // internal lane it crosses the junction on, admit the class (or the connection's own
+  // permissions do, where it has them).
+  [[nodiscard]] bool admits(const SumoConnection& c, SumoClasses cls) const;
+  // (Re)builds the id index; call after changing edges or junctions.
+  void build_index();
+
+  std::unordered_map<std::string, std::size_t> edge_index;
+  std::unordered_map<std::string, std::size_t> junction_index;
+  std::unordered_map<std::string, std::pair<std::size_t, std::size_t>> lane_index;  // edge, lane
 };
 
 // Throws MapLoadError for a missing file or malformed XML, naming the file and line.

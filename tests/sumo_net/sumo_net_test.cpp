@@ -183,3 +183,88 @@ TEST(SumoGraph, SignalPlansSitOnTheStopLinesTheirLightControlsWithExactMovements
 
 }  // namespace
 }  // namespace corridor::maps
+
+#include "planner/cost_overlay.hpp"
+#include "planner/one_to_one_search.hpp"
+#include "planner/travel_cost.hpp"
+
+namespace corridor::maps {
+namespace {
+
+// tests/data/lane_permissions: AB is a bus lane, AE -> EC a connection only buses may take.
+const SumoNet& permissions_net() {
+  static const SumoNet net = read_sumo_net(CORRIDOR_PERMISSIONS_NET);
+  return net;
+}
+
+std::vector<std::string> shortest_route(const SumoGraph& g, const std::string& from, const std::string& to) {
+  const planner::CostOverlay overlay(g.graph);
+  const planner::TravelCost cost(g.graph, overlay, {});
+  std::vector<planner::EdgePoint> starts, goals;
+  for (EdgeId e : g.arcs(from)) starts.push_back({e, 0.0});
+  for (EdgeId e : g.arcs(to)) goals.push_back({e, g.graph.length_m(e)});
+  planner::OneToOneSearch search;
+  const planner::Route r = search.run(planner::SearchSpace(cost, starts, goals), true);
+  std::vector<std::string> ids;
+  for (EdgeId e : r.edges) ids.push_back(g.sumo_edge_of_arc[e.index()]);
+  return ids;
+}
+
+bool has_arc(const SumoGraph& g, const std::string& from, const std::string& onto) {
+  for (EdgeId e : g.arcs(onto)) {
+    if (g.sumo_edge_of_node[g.graph.tail(e).index()] == from) return true;
+  }
+  return false;
+}
+
+TEST(SumoPermissions, LanesAndConnectionsAdmitTheClassesTheyAllow) {
+  const SumoNet& net = permissions_net();
+  const SumoEdge* ab = net.edge("AB");
+  ASSERT_NE(ab, nullptr);
+  EXPECT_TRUE(ab->admits(*sumo_class_bit("bus")));
+  EXPECT_FALSE(ab->admits(*sumo_class_bit("emergency")));
+  EXPECT_TRUE(net.edge("AD")->admits(*sumo_class_bit("emergency")));
+  const auto connection = [&](const std::string& from, const std::string& to) {
+    for (const auto& c : net.connections) {
+      if (c.from == from && c.to == to) return &c;
+    }
+    return static_cast<const SumoConnection*>(nullptr);
+  };
+  ASSERT_NE(connection("AE", "EC"), nullptr);
+  EXPECT_TRUE(net.admits(*connection("AE", "EC"), *sumo_class_bit("bus")));
+  EXPECT_FALSE(net.admits(*connection("AE", "EC"), *sumo_class_bit("emergency")));
+  EXPECT_TRUE(net.admits(*connection("AD", "DC"), *sumo_class_bit("emergency")));
+  // The internal lane alone carries the rule too, where a connection has no attribute of its own.
+  SumoConnection bare = *connection("AE", "EC");
+  bare.allowed.reset();
+  EXPECT_FALSE(net.admits(bare, *sumo_class_bit("emergency")));
+}
+
+TEST(SumoPermissions, AnEmergencyVehiclesGraphAvoidsTheBusLaneAndTheBusOnlyTurn) {
+  const SumoGraph ev = build_sumo_graph(permissions_net(), "emergency");
+  EXPECT_TRUE(ev.arcs("AB").empty());
+  EXPECT_FALSE(has_arc(ev, "AE", "EC"));
+  EXPECT_TRUE(has_arc(ev, "AD", "DC"));
+  EXPECT_EQ(shortest_route(ev, "SA", "CG"), (std::vector<std::string>{"SA", "AD", "DC", "CG"}));
+  const SumoGraph bus = build_sumo_graph(permissions_net(), "bus");
+  EXPECT_TRUE(has_arc(bus, "SA", "AB"));
+  EXPECT_TRUE(has_arc(bus, "AE", "EC"));
+  EXPECT_EQ(shortest_route(bus, "SA", "CG"), (std::vector<std::string>{"SA", "AB", "BC", "CG"}));
+  EXPECT_THROW((void)build_sumo_graph(permissions_net(), "hovercraft"), MapLoadError);
+}
+
+TEST(SumoPermissions, AllowAndDisallowAsSumoReadsThem) {
+  const SumoClasses bus = *sumo_class_bit("bus"), ev = *sumo_class_bit("emergency"), car = *sumo_class_bit("passenger");
+  EXPECT_EQ(parse_sumo_permissions("", ""), kAllSumoClasses);
+  EXPECT_EQ(parse_sumo_permissions("bus emergency", ""), bus | ev);
+  EXPECT_EQ(parse_sumo_permissions("", "passenger bus") & (bus | car), 0u);
+  EXPECT_NE(parse_sumo_permissions("", "passenger bus") & ev, 0u);
+  EXPECT_EQ(parse_sumo_permissions("all", ""), kAllSumoClasses);
+  EXPECT_EQ(parse_sumo_permissions("", "all"), 0u);
+  // A class a newer SUMO has (and this one does not) admits none of this SUMO's vehicles.
+  EXPECT_EQ(parse_sumo_permissions("scooter", ""), 0u);
+  EXPECT_EQ(sumo_class_names(bus | ev), "emergency bus");
+}
+
+}  // namespace
+}  // namespace corridor::maps
