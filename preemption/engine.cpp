@@ -104,7 +104,41 @@ std::optional<PreemptionEngine::VicinityStart> PreemptionEngine::vicinity_start(
   return best;
 }
 
-bool PreemptionEngine::time_entry(ScheduleEntry& e, const Crossing& c, const Crossing* previous, double now_s) {
+std::optional<double> PreemptionEngine::foreseen_start(const ScheduleEntry& e, double green_by_s, double now_s) const {
+  if (green_by_s <= now_s) return std::nullopt;
+  const maps::SignalPlan& plan = plans_.at(e.node);
+  const std::vector<ProgramInterval> forecast = controller_.program_forecast(e.node, now_s, green_by_s - now_s);
+  if (forecast.empty()) return std::nullopt;
+  const auto serves = [&](const std::vector<std::uint8_t>& green) {
+    return std::all_of(e.movements.begin(), e.movements.end(), [&](std::size_t m) { return m < green.size() && green[m]; });
+  };
+  const double clear_s = plan.yellow_s + plan.all_red_s;
+  // A hold that starts while its movements are green keeps them green. One that starts where they
+  // are red ends the phase on show once its minimum green is served, then clears: Trans.
+  const double step_s = config_.timing.safety_margin_s;  // the hold starts a tick or two before a program change
+  std::optional<double> latest;
+  for (const ProgramInterval& iv : forecast) {
+    if (iv.start_s > green_by_s) break;
+    const double lo = std::max(iv.start_s, now_s);
+    double candidate = -1.0;
+    if (serves(iv.green)) {
+      // Through the interval; before its end, so that the program's own change is not begun.
+      candidate = std::min(green_by_s, iv.end_s - step_s);
+    } else if (iv.clearance) {
+      // The held phase takes green as the clearance ends.
+      if (iv.end_s <= green_by_s) candidate = std::min(iv.end_s, green_by_s) - step_s;
+    } else if (iv.min_green_end_s + clear_s <= green_by_s) {
+      candidate = std::min(iv.end_s - step_s, green_by_s - clear_s);
+    }
+    if (candidate >= lo) latest = std::max(latest.value_or(candidate), candidate);
+  }
+  // The forecast covers the whole wait and no start in it is late enough: the hold must begin now.
+  if (!latest && forecast.back().end_s >= green_by_s) return now_s;
+  return latest;
+}
+
+bool PreemptionEngine::time_entry(ScheduleEntry& e, std::span<const Crossing> group, const Crossing* previous, double now_s) {
+  const Crossing& c = group.front();
   const maps::SignalPlan& plan = plans_.at(c.node);
   const maps::Compass from = maps::approach_side(graph_, c.in_edge);
   const std::optional<std::size_t> movement = plan_movement(graph_, plan, c.in_edge, c.out_edge);
@@ -113,6 +147,15 @@ bool PreemptionEngine::time_entry(ScheduleEntry& e, const Crossing& c, const Cro
   e.movement = *movement;
   e.movement_label = plan.movements[*movement].label();
   e.arrival_s = c.arrival_s;
+  e.movements = {*movement};
+  e.lines.clear();
+  for (const Crossing& g : group) {
+    e.lines.push_back(g.in_edge);
+    if (&g == &c) continue;
+    const std::optional<std::size_t> m = plan_movement(graph_, plan, g.in_edge, g.out_edge);
+    if (m && std::find(e.movements.begin(), e.movements.end(), *m) == e.movements.end()) e.movements.push_back(*m);
+  }
+  const std::span<const std::size_t> also(e.movements.data() + 1, e.movements.size() - 1);
 
   const QueueEstimator* queue = nullptr;
   if (auto it = queues_.find(c.node); it != queues_.end() && it->second.has_data(from)) queue = &it->second;
@@ -137,10 +180,11 @@ bool PreemptionEngine::time_entry(ScheduleEntry& e, const Crossing& c, const Cro
     }
   }
 
-  // An active hold keeps its phase unless the vehicle's movement changed.
-  const bool keep = e.state == EntryState::active && e.phase.serves(e.movement);
+  // An active hold keeps its phase unless the vehicle's movements changed.
+  const bool keep = e.state == EntryState::active &&
+                    std::all_of(e.movements.begin(), e.movements.end(), [&](std::size_t m) { return e.phase.serves(m); });
   const PhaseDecision decision =
-      select_phase(plan, e.movement, controller_.current_phase(c.node), e.congestion, demand);
+      select_phase(plan, e.movement, controller_.current_phase(c.node), e.congestion, demand, also);
   if (!keep) e.phase = decision.phase;
 
   // Gedawy: p = τ − Trans − margin (− t_q(τ) under congestion).
@@ -159,13 +203,27 @@ bool PreemptionEngine::time_entry(ScheduleEntry& e, const Crossing& c, const Cro
     clearance = queue_clearance_s(queue_at_arrival_veh(e.arrival_s, q, config_.timing), config_.timing);
   }
   e.natural_start_s = std::max(now_s, preemption_start_s(e.arrival_s, trans, clearance, config_.timing));
+  // Trans is what the phase on show needs now; the program may change before the start comes: end
+  // the green that serves the vehicle just before its arrival, or begin a phase whose minimum green
+  // outlasts the start. Where the controller foresees its program, the start is the latest one that
+  // still has the vehicle's movements green by then, if that is earlier.
+  if (!keep && e.state != EntryState::active) {
+    if (const auto foreseen = foreseen_start(e, e.arrival_s - config_.timing.safety_margin_s - clearance, now_s)) {
+      if (*foreseen < e.natural_start_s - 1e-9) {
+        e.natural_start_s = std::max(now_s, *foreseen);
+        e.foreseen = true;
+      } else {
+        e.foreseen = false;
+      }
+    }
+  }
   e.vicinity.clear();
   if (vicinity && vicinity->start_s < e.natural_start_s) {
     e.natural_start_s = vicinity->start_s;
     e.vicinity = vicinity->spillback ? "spillback" : "approach_queue";
   }
   if (e.state == EntryState::active) e.natural_start_s = std::min(e.natural_start_s, e.started_s);
-  e.release_s = e.arrival_s + config_.release_after_arrival_s;
+  e.release_s = group.back().arrival_s + config_.release_after_arrival_s;
   return true;
 }
 
@@ -287,8 +345,15 @@ void PreemptionEngine::update_route(MissionId mission, int priority, std::span<c
   std::vector<NodeId> touched;
   std::vector<NodeId> on_route;
   const Crossing* previous = nullptr;
-  for (const Crossing& c : crossings) {
-    const Crossing* previous_crossing = std::exchange(previous, &c);
+  for (std::size_t i = 0; i < crossings.size();) {
+    // The run of consecutive crossings of one signal: one hold serves them all, so that a light over
+    // several joined junctions is not released and taken again between two of its stop lines.
+    std::size_t j = i + 1;
+    while (j < crossings.size() && crossings[j].node == crossings[i].node) ++j;
+    const std::span<const Crossing> group = crossings.subspan(i, j - i);
+    const Crossing& c = group.front();
+    const Crossing* previous_crossing = std::exchange(previous, &crossings[j - 1]);
+    i = j;
     if (plans_.count(c.node) == 0 || std::find(on_route.begin(), on_route.end(), c.node) != on_route.end()) continue;
     if (exhausted_.count({mission, c.node}) != 0) continue;
     on_route.push_back(c.node);
@@ -299,20 +364,23 @@ void PreemptionEngine::update_route(MissionId mission, int priority, std::span<c
     if (existing != nullptr) {
       const double before = existing->natural_start_s;
       existing->priority = priority;
-      if (!time_entry(*existing, c, previous_crossing, now_s)) {
+      if (!time_entry(*existing, group, previous_crossing, now_s)) {
         finish(*existing, EntryState::cancelled, now_s, "reason=no_movement");
       } else if (std::abs(existing->natural_start_s - before) > 0.5) {
-        log(now_s, mission, c.node, "retimed", "start_s=" + fmt_s(existing->natural_start_s) + " arrival_s=" + fmt_s(existing->arrival_s));
+        log(now_s, mission, c.node, "retimed",
+            "start_s=" + fmt_s(existing->natural_start_s) + " arrival_s=" + fmt_s(existing->arrival_s) +
+                (existing->foreseen ? " foreseen=program" : ""));
       }
     } else {
       auto e = std::make_unique<ScheduleEntry>();
       e->mission = mission;
       e->priority = priority;
-      if (!time_entry(*e, c, previous_crossing, now_s)) continue;
+      if (!time_entry(*e, group, previous_crossing, now_s)) continue;
       log(now_s, mission, c.node, "scheduled",
           "phase=" + e->phase.label + " start_s=" + fmt_s(e->natural_start_s) + " arrival_s=" + fmt_s(e->arrival_s) +
               " congestion=" + (e->congestion == CongestionLevel::high ? "high" : "low") +
-              (e->vicinity.empty() ? "" : " vicinity=" + e->vicinity));
+              (e->vicinity.empty() ? "" : " vicinity=" + e->vicinity) + (e->foreseen ? " foreseen=program" : "") +
+              (e->lines.size() > 1 ? " stop_lines=" + std::to_string(e->lines.size()) : ""));
       nodes_[c.node].entries.push_back(e.get());
       entries.push_back(std::move(e));
     }
@@ -418,8 +486,15 @@ void PreemptionEngine::vehicle_passed(MissionId mission, NodeId node, double now
   if (it == missions_.end()) return;
   std::vector<NodeId> touched;
   for (auto& e : it->second) {
+    if (!is_live(*e)) continue;
+    // A light over several joined junctions holds until the vehicle has crossed its last stop line.
+    if (e->node == node && !e->flush_for && e->lines.size() > 1) {
+      e->lines.erase(e->lines.begin());
+      log(now_s, mission, node, "line_crossed", "stop_lines_left=" + std::to_string(e->lines.size()));
+      continue;
+    }
     // Its own hold at the node, and the side links flushed for it there.
-    if (is_live(*e) && ((e->node == node && !e->flush_for) || e->flush_for == node)) {
+    if ((e->node == node && !e->flush_for) || e->flush_for == node) {
       finish(*e, EntryState::released, now_s, "reason=vehicle_cleared_stop_line");
       touched.push_back(e->node);
     }

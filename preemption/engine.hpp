@@ -75,6 +75,12 @@ struct ScheduleEntry {
   NodeId node;
   std::size_t movement = 0;
   std::string movement_label;
+  // Every movement the vehicle makes at this signal, in order: one, or one per stop line where a
+  // light controls several joined junctions and the route crosses them one after the other.
+  std::vector<std::size_t> movements;
+  // The stop lines (their approach edges) the vehicle has still to cross under this hold; the hold
+  // is released once it has crossed the last.
+  std::vector<EdgeId> lines;
   maps::Phase phase;
   CongestionLevel congestion = CongestionLevel::low;
   double natural_start_s = 0;  // from the timing equations alone
@@ -87,6 +93,8 @@ struct ScheduleEntry {
   // Why a vicinity rule moved the start earlier: "approach_queue", "spillback", or
   // "side_spillback" for a flush of a link off the route; empty otherwise.
   std::string vicinity;
+  // The start was moved earlier because the controller foresees its program changing before then.
+  bool foreseen = false;
   // A side-link flush: the crossing on the route whose blocking it clears (released when the
   // vehicle passes that crossing); empty for the route's own holds.
   std::optional<NodeId> flush_for;
@@ -145,8 +153,12 @@ class PreemptionEngine {
   };
 
   // False when the crossing has no movement in the plan (a U-turn into the approach it came from).
-  // `previous` is the signalized crossing before `c` on the route, if any.
-  bool time_entry(ScheduleEntry& e, const Crossing& c, const Crossing* previous, double now_s);
+  // `group` is the route's consecutive crossings of one signal (one, unless the signal controls
+  // several joined junctions), `previous` the signalized crossing before them, if any.
+  bool time_entry(ScheduleEntry& e, std::span<const Crossing> group, const Crossing* previous, double now_s);
+  // The latest start from which the controller, running its program until then, shows every
+  // movement of `e` green by `green_by_s`; nullopt where it cannot foresee its program that far.
+  [[nodiscard]] std::optional<double> foreseen_start(const ScheduleEntry& e, double green_by_s, double now_s) const;
   // The vicinity rules' start for a crossing, and which rule set it; nullopt when neither applies.
   struct VicinityStart {
     double start_s;

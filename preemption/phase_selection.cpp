@@ -27,11 +27,19 @@ std::size_t approach_movements_served(const maps::SignalPlan& plan, const maps::
   return n;
 }
 
-maps::Phase synthesize(const maps::SignalPlan& plan, std::size_t movement) {
+maps::Phase synthesize(const maps::SignalPlan& plan, std::size_t movement, std::span<const std::size_t> also) {
   maps::Phase phase;
   phase.label = "preempt:" + plan.movements[movement].label();
   phase.green.assign(plan.movements.size(), 0);
   phase.green[movement] = 1;
+  for (std::size_t m : also) {
+    // The vehicle's own later movements, where they conflict with nothing already green.
+    bool compatible = true;
+    for (std::size_t g = 0; g < plan.movements.size(); ++g) compatible = compatible && !(phase.green[g] && plan.conflicts(g, m));
+    if (!compatible || phase.green[m]) continue;
+    phase.green[m] = 1;
+    phase.label += "+" + plan.movements[m].label();
+  }
   phase.min_green_s = plan.phases.empty() ? 5.0 : plan.phases.front().min_green_s;
   auto add_compatible = [&](bool same_approach) {
     for (std::size_t m = 0; m < plan.movements.size(); ++m) {
@@ -51,13 +59,14 @@ maps::Phase synthesize(const maps::SignalPlan& plan, std::size_t movement) {
 }  // namespace
 
 PhaseDecision select_phase(const maps::SignalPlan& plan, std::size_t movement, std::optional<std::size_t> current,
-                           CongestionLevel level, std::span<const double> demand) {
+                           CongestionLevel level, std::span<const double> demand, std::span<const std::size_t> also) {
   const maps::Compass from = plan.movements.at(movement).from;
   std::vector<std::size_t> candidates;
   for (std::size_t p = 0; p < plan.phases.size(); ++p) {
-    if (plan.phases[p].serves(movement) && plan.phase_is_safe(plan.phases[p])) candidates.push_back(p);
+    const bool serves_all = std::all_of(also.begin(), also.end(), [&](std::size_t m) { return plan.phases[p].serves(m); });
+    if (plan.phases[p].serves(movement) && serves_all && plan.phase_is_safe(plan.phases[p])) candidates.push_back(p);
   }
-  if (candidates.empty()) return {synthesize(plan, movement), std::nullopt, false};
+  if (candidates.empty()) return {synthesize(plan, movement, also), std::nullopt, false};
 
   // Only a safe phase that serves the movement may be extended; a SUMO phase with permissive
   // greens serves it but is not safe to hold.

@@ -24,10 +24,12 @@ struct PhaseDecision {
 // nothing); empty when there are no detectors, and then through and right movements count 2,
 // lefts 1. Ties go to the earlier phase in plan order, so the decision is deterministic. Where no
 // phase of the plan serves the movement, a phase is synthesized: the vehicle's movement and as many
-// of its approach's movements as are mutually compatible, everything else red.
+// of its approach's movements as are mutually compatible, everything else red. `also` are further
+// movements the phase must serve with it (a light over several joined junctions that the vehicle
+// crosses one after the other).
 PhaseDecision select_phase(const maps::SignalPlan& plan, std::size_t movement,
                            std::optional<std::size_t> current_phase, CongestionLevel level,
-                           std::span<const double> demand = {});
+                           std::span<const double> demand = {}, std::span<const std::size_t> also = {});
 
 // The seed paper's two 12 × 8 tables for the NEMA plan: rows are movements (plan order), columns
 // the eight phases as the current phase, cells the chosen phase's label.

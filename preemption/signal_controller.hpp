@@ -19,6 +19,17 @@ enum class SignalMode : std::uint8_t {
   held,     // preempted: moving to or holding a phase for an emergency vehicle
 };
 
+// A stretch of time over which the normal program shows one set of greens, as the controller
+// foresees it: a phase's green, or the clearance between two phases (whose greens are then the
+// movements green on both sides of it).
+struct ProgramInterval {
+  double start_s = 0.0;
+  double end_s = 0.0;
+  std::vector<std::uint8_t> green;  // per movement, 1 = green throughout
+  bool clearance = false;           // yellow and all-red between two phases
+  double min_green_end_s = 0.0;     // a phase: when its minimum green is served
+};
+
 class SignalController {
  public:
   virtual ~SignalController() = default;
@@ -33,6 +44,14 @@ class SignalController {
   [[nodiscard]] virtual std::optional<std::size_t> current_phase(NodeId node) const = 0;
   // When `movement`'s current green began (t_G0), or nullopt while it is not green.
   [[nodiscard]] virtual std::optional<double> green_start_s(NodeId node, std::size_t movement) const = 0;
+  // What the normal program will show from now_s on, interval by interval, for at least horizon_s
+  // where the controller can tell (a fixed program), less where it cannot (an actuated phase's
+  // length), and nothing while it holds or clears for a hold: the engine then times a start from
+  // what is on show now alone.
+  [[nodiscard]] virtual std::vector<ProgramInterval> program_forecast(NodeId /*node*/, double /*now_s*/,
+                                                                      double /*horizon_s*/) const {
+    return {};
+  }
 };
 
 }  // namespace corridor::preemption

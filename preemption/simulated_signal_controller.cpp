@@ -194,6 +194,51 @@ std::optional<double> SimulatedSignalController::green_start_s(NodeId node, std:
   return s.green_start[movement];
 }
 
+std::vector<ProgramInterval> SimulatedSignalController::program_forecast(NodeId node, double now_s, double horizon_s) const {
+  const State& s = state(node);
+  std::vector<ProgramInterval> out;
+  if (s.mode != SignalMode::program) return out;
+  const maps::SignalPlan& plan = *s.plan;
+  const auto green_of = [&](std::size_t step) -> const std::vector<std::uint8_t>& { return plan.phases[plan.program[step].phase].green; };
+  const auto both = [](const std::vector<std::uint8_t>& a, const std::vector<std::uint8_t>& b) {
+    std::vector<std::uint8_t> c(a.size(), 0);
+    for (std::size_t m = 0; m < a.size(); ++m) c[m] = a[m] && b[m];
+    return c;
+  };
+  std::size_t step = s.step;
+  double t = now_s;  // where the next interval starts
+  if (s.stage == Stage::green && s.shown == desired(s)) {
+    const double end = std::max(s.step_green_start_s + plan.program[step].green_s, s.green_since_s + s.min_green_s);
+    out.push_back({now_s, std::max(end, now_s), s.shown, false, s.green_since_s + s.min_green_s});
+    t = out.back().end_s;
+  } else if (s.stage != Stage::green) {
+    // A program clearance: yellow (what is left of it), then all-red, towards the step's phase.
+    const double end = s.stage == Stage::yellow ? s.stage_start_s + plan.yellow_s + plan.all_red_s : s.stage_start_s + plan.all_red_s;
+    out.push_back({now_s, std::max(end, now_s), both(s.shown, green_of(step)), true, 0.0});
+    t = out.back().end_s;
+    const maps::Phase& phase = plan.phases[plan.program[step].phase];
+    out.push_back({t, t + std::max(plan.program[step].green_s, phase.min_green_s), phase.green, false, t + phase.min_green_s});
+    t = out.back().end_s;
+  } else {
+    return out;  // green, but not the step's own phase: on its way back from a hold
+  }
+  // Bounded: a cycle per pass, and a horizon of minutes.
+  for (int guard = 0; t < now_s + horizon_s && guard < 1000; ++guard) {
+    const std::size_t next = (step + 1) % plan.program.size();
+    const auto& from = green_of(step);
+    const auto& to = green_of(next);
+    if (!subset(from, to)) {
+      out.push_back({t, t + plan.yellow_s + plan.all_red_s, both(from, to), true, 0.0});
+      t = out.back().end_s;
+    }
+    const maps::Phase& phase = plan.phases[plan.program[next].phase];
+    out.push_back({t, t + std::max(plan.program[next].green_s, phase.min_green_s), phase.green, false, t + phase.min_green_s});
+    t = out.back().end_s;
+    step = next;
+  }
+  return out;
+}
+
 const std::vector<Light>& SimulatedSignalController::lights(NodeId node) const { return state(node).lights; }
 
 bool SimulatedSignalController::running_program(NodeId node) const {

@@ -29,6 +29,8 @@ class SimulatedSignalController final : public SignalController {
   [[nodiscard]] double remaining_min_green_s(NodeId node, double now_s) const override;
   [[nodiscard]] std::optional<std::size_t> current_phase(NodeId node) const override;
   [[nodiscard]] std::optional<double> green_start_s(NodeId node, std::size_t movement) const override;
+  // Exact for the program it runs, from a program phase on show or a program clearance.
+  [[nodiscard]] std::vector<ProgramInterval> program_forecast(NodeId node, double now_s, double horizon_s) const override;
 
   [[nodiscard]] const std::vector<Light>& lights(NodeId node) const;
   // True while nothing is being cleared and the program's own phase is on show.

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 #include "maps/graph_builder.hpp"
@@ -569,6 +570,127 @@ TEST(VicinityPreemption, EarlyStartIsBoundedByTheMaximumLead) {
 // Property test: many random missions with planner routes over a grid of signalized junctions,
 // random arrivals (some vehicles never come), reroutes and cancels. No safety violation ever, and
 // every junction is back in its normal program within a bounded time once the missions are over.
+
+// The program's own green for the vehicle can end just before it arrives: the start taken from what
+// is on show (extend, so no Trans) would fall into the next phase's minimum green. For every
+// arrival in the cycle the vehicle's movement must be green when it arrives, re-timed every second
+// as a moving vehicle is.
+TEST(PreemptionEngine, AGreenTheProgramEndsBeforeTheArrivalIsForeseen) {
+  const std::size_t n_s = [] {
+    Rig rig;
+    return *rig.plan().movement_index(maps::Compass::north, maps::Compass::south);
+  }();
+  // When the program, left alone, first ends N->S's green.
+  double green_ends = 0.0;
+  {
+    Rig rig;
+    for (double t = 0.0; t < 200.0; t += 0.5) {
+      rig.controller.advance(t);
+      if (rig.controller.lights(rig.c)[n_s] != Light::green) {
+        green_ends = t;
+        break;
+      }
+    }
+  }
+  ASSERT_GT(green_ends, 10.0);
+  std::vector<double> red_at_arrival;
+  for (double arrival = green_ends - 8.0; arrival <= green_ends + 30.0; arrival += 1.0) {
+    Rig rig;
+    for (double t = 0.0; t <= arrival; t += 0.5) {
+      rig.controller.advance(t);
+      if (std::fmod(t, 1.0) == 0.0) rig.engine.update_route(1, 1, std::vector<Crossing>{rig.crossing(kN, kS, arrival)}, t);
+      rig.engine.tick(t);
+    }
+    if (rig.controller.lights(rig.c)[n_s] != Light::green) red_at_arrival.push_back(arrival);
+    rig.engine.vehicle_passed(1, rig.c, arrival + 1.0);
+    rig.run_until(arrival + 40.0);
+    EXPECT_TRUE(rig.monitor.violations().empty()) << rig.monitor.violations().front();
+  }
+  EXPECT_TRUE(red_at_arrival.empty()) << red_at_arrival.size() << " arrivals met a red light, the first at "
+                                      << red_at_arrival.front() << " s (the program ends the green at " << green_ends << " s)";
+}
+
+// Two junctions joined under one light (SUMO's cluster_*), crossed one after the other: one hold
+// serves both stop lines, is kept when the vehicle crosses the first, and ends after the second.
+TEST(PreemptionEngine, ALightOverJoinedJunctionsIsHeldAcrossAllItsStopLines) {
+  // W - A - B - E, with side legs north and south of A and of B, 40 m apart.
+  maps::GraphBuildInput in;
+  in.origin = {47.0, 9.5};
+  in.node_pos = {{-300, 0}, {0, 0}, {40, 0}, {340, 0}, {0, 200}, {0, -200}, {40, 200}, {40, -200}};
+  for (std::int64_t i = 0; i < 8; ++i) in.node_osm.push_back(OsmNodeId{i + 1});
+  in.node_signalized = {0, 1, 1, 0, 0, 0, 0, 0};
+  const std::vector<std::pair<std::uint32_t, std::uint32_t>> legs{{0, 1}, {1, 2}, {2, 3}, {4, 1}, {1, 5}, {6, 2}, {2, 7}};
+  for (const auto& [a, b] : legs) {
+    maps::RoadSegment seg;
+    seg.from = a;
+    seg.to = b;
+    seg.first_point = static_cast<std::uint32_t>(in.points.size());
+    in.points.push_back(in.node_pos[a]);
+    in.points.push_back(in.node_pos[b]);
+    seg.last_point = seg.first_point + 1;
+    seg.forward_speed_mps = seg.backward_speed_mps = 14.0f;
+    seg.way = OsmWayId{static_cast<std::int64_t>(a * 10 + b)};
+    in.segments.push_back(seg);
+  }
+  const maps::RoadGraph g = maps::build_road_graph(in);
+  const auto node = [&](std::int64_t osm) {
+    for (std::uint32_t v = 0; v < g.node_count(); ++v) {
+      if (g.osm_node(NodeId{v}).v == osm) return NodeId{v};
+    }
+    return NodeId{};
+  };
+  const auto arc = [&](std::int64_t a, std::int64_t b) { return edge(g, a, b); };
+  const NodeId a = node(2), b = node(3);
+  // Movements: 0 W->A->B, 1 A->B->E, 2 north->south at A, 3 north->south at B; 0 and 2 cross, as do
+  // 1 and 3. No phase of the program serves 0 and 1 together.
+  maps::SignalPlan plan;
+  plan.node = a;
+  plan.movements = {{maps::Compass::west, maps::Compass::east, maps::Turn::through, 0},
+                    {maps::Compass::west, maps::Compass::east, maps::Turn::through, 0},
+                    {maps::Compass::north, maps::Compass::south, maps::Turn::through, 0},
+                    {maps::Compass::north, maps::Compass::south, maps::Turn::through, 0}};
+  plan.conflict.assign(16, 0);
+  plan.conflict[0 * 4 + 2] = plan.conflict[2 * 4 + 0] = plan.conflict[1 * 4 + 3] = plan.conflict[3 * 4 + 1] = 1;
+  plan.movement_edge = {arc(2, 3), arc(3, 4), arc(2, 6), arc(3, 8)};
+  plan.phases = {{"sides", {0, 0, 1, 1}, 5.0}, {"A-west", {1, 0, 0, 1}, 5.0}, {"B-west", {0, 1, 1, 0}, 5.0}};
+  plan.program = {{0, 30.0}, {1, 20.0}, {2, 20.0}};
+  std::unordered_map<NodeId, maps::SignalPlan> plans{{a, plan}};
+  SimulatedSignalController controller(plans, 0.0);
+  SafetyMonitor monitor;
+  monitor.watch(plans.at(a), controller.lights(a), 0.0);
+  controller.set_observer([&](NodeId n, const std::vector<Light>& l, double t) { monitor.observe(n, l, t); });
+  PreemptionEngine engine(g, plans, controller);
+  engine.set_signal_nodes({{b, a}});
+  // The two crossings as the caller gives them: both keyed by the light's node.
+  const auto crossings = [&](double first_s) {
+    return std::vector<Crossing>{{a, arc(1, 2), arc(2, 3), first_s, 300.0}, {a, arc(2, 3), arc(3, 4), first_s + 3.0, 340.0}};
+  };
+  engine.update_route(1, 1, crossings(40.0), 0.0);
+  ASSERT_EQ(engine.schedule(1).size(), 1u);
+  EXPECT_EQ(engine.schedule(1)[0].lines.size(), 2u);
+  EXPECT_TRUE(engine.schedule(1)[0].phase.serves(0) && engine.schedule(1)[0].phase.serves(1)) << engine.schedule(1)[0].phase.label;
+  for (double t = 0.0; t <= 40.0; t += 0.5) {
+    controller.advance(t);
+    engine.tick(t);
+  }
+  EXPECT_EQ(controller.lights(a)[0], Light::green);
+  EXPECT_EQ(controller.lights(a)[1], Light::green);
+  engine.vehicle_passed(1, a, 40.5);  // the first stop line
+  engine.update_route(1, 1, std::vector<Crossing>{{a, arc(2, 3), arc(3, 4), 43.0, 40.0}}, 40.5);
+  for (double t = 40.5; t <= 43.0; t += 0.5) {
+    controller.advance(t);
+    engine.tick(t);
+  }
+  EXPECT_TRUE(engine.holding(a));
+  EXPECT_EQ(controller.lights(a)[1], Light::green);
+  for (const auto& e : engine.take_events()) EXPECT_NE(e.kind, "released") << "released at " << e.time_s << " s, before the second line";
+  engine.vehicle_passed(1, a, 43.5);  // the second
+  EXPECT_EQ(engine.schedule(1)[0].state, EntryState::released);
+  EXPECT_FALSE(engine.holding(a));
+  for (double t = 43.5; t <= 120.0; t += 0.5) controller.advance(t);
+  EXPECT_TRUE(monitor.violations().empty()) << monitor.violations().front();
+}
+
 TEST(PreemptionEngine, RandomMissionsNeverBreakSafetyAndSignalsRecover) {
   for (std::uint64_t seed = 1; seed <= 12; ++seed) {
     maps::GridSpec spec;
