@@ -11,8 +11,9 @@
 #include <memory>
 
 #include "app/cli_error.hpp"
+#include "maps/sumo_vehicle_class.hpp"
 #include "sim/closed_loop.hpp"
-#include "sim/result_json.hpp"
+#include "sim/run_record.hpp"
 #include "sim/sumo_experiment.hpp"
 #include "sim/scenario_builder.hpp"
 #include "sim/sumo_scenario.hpp"
@@ -49,6 +50,8 @@ struct SimOptions {
   double inject_vph = 0.0;
   bool route_only = false;
   bool time_space = false;
+  std::string ev_vclass = "emergency";
+  bool rebuild_net = false;
 };
 
 sim::EvRouting parse_routing(const std::string& s) {
@@ -69,14 +72,17 @@ void run_sim(const SimOptions& o) {
   if (o.end_s && !(*o.end_s > o.ev_depart_s)) throw UsageError("--end-s must come after --ev-depart-s");
   const auto routing = parse_routing(o.routing);
   const auto signals = parse_signals(o.signals);
-  const auto net = sim::build_scenario_net(o.scenario, o.work_dir);
+  if (!maps::sumo_class_bit(o.ev_vclass)) {
+    throw UsageError("--ev-vclass must be a SUMO vehicle class (emergency, passenger, bus, ...), got '" + o.ev_vclass + "'");
+  }
+  const auto net = sim::build_scenario_net(o.scenario, o.work_dir, {o.rebuild_net});
   if (net.config && !o.background_routes.empty()) {
     throw UsageError("--background-routes is for generated scenarios; a .sumocfg brings its own demand (use --demand-scale)");
   }
   if (!net.config && o.demand_scale != 1.0) {
     throw UsageError("--demand-scale scales a .sumocfg scenario's own demand; a generated scenario takes --volume");
   }
-  const auto scenario = sim::load_sumo_scenario(net);
+  const auto scenario = sim::load_sumo_scenario(net, o.ev_vclass);
   // Times are after the scenario's begin: 0 for generated scenarios, the configuration's begin else.
   const double begin_s = net.config ? net.config->begin_s : 0.0;
   const double end_after_begin =
@@ -169,17 +175,19 @@ void run_sim(const SimOptions& o) {
   record.ev_depart_s = c.ev_depart_s;
   record.vicinity = c.vicinity && o.server.empty();  // the server's engine runs route-only
   record.evs = o.evs;
-  record.result = sim::run_closed_loop(*scenario, c);
-  const std::string text = sim::to_json_record(record).dump(2);
-  if (!o.result_file.empty()) {
-    // Written whole under a temporary name, then renamed: a collector never reads half a record.
-    const std::filesystem::path file(o.result_file);
-    if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
-    const auto tmp = file.string() + ".tmp";
-    std::ofstream(tmp, std::ios::trunc) << text << '\n';
-    std::filesystem::rename(tmp, file);
+  if (!net.rebuilt_from.empty()) {
+    std::cerr << "corridor sim: " << net.rebuilt_from.string() << " was written by a newer netconvert; this run uses its "
+              << "conversion by the installed one, " << net.net.string() << "\n";
   }
-  std::cout << text << '\n';
+  try {
+    record.result = sim::run_closed_loop(*scenario, c);
+  } catch (const std::exception& e) {
+    // A failed run is a record too, so that a collected matrix shows it as a row with its reason.
+    if (!o.result_file.empty()) sim::write_record(o.result_file, sim::failed_run(record, e.what()));
+    throw;
+  }
+  if (!o.result_file.empty()) sim::write_record(o.result_file, record);
+  std::cout << sim::to_json_record(record).dump(2) << '\n';
 }
 
 }  // namespace
@@ -226,6 +234,11 @@ void register_sim_command(CLI::App& app) {
   cmd->add_option("--inject-vph", o->inject_vph,
                   "the seed's Fig. 11: a flow of this many vehicles/hour along the EV's static route")
       ->capture_default_str();
+  cmd->add_option("--ev-vclass", o->ev_vclass,
+                  "the EV's SUMO vehicle class: its routes use only lanes and connections SUMO allows it")
+      ->capture_default_str();
+  cmd->add_flag("--rebuild-net", o->rebuild_net,
+                "a net written by a newer netconvert is converted with the installed one into the work directory");
   cmd->add_flag("--time-space", o->time_space,
                 "write the EVs' trajectories and lights (RUN.ev_trajectory.csv, RUN.ev_signals.csv, RUN.time_space.svg)");
   cmd->callback([o] { run_sim(*o); });
@@ -285,14 +298,29 @@ void register_sumo_experiment(CLI::App& experiment) {
   cmd->add_flag("--inject-on-route", o->inject_on_route,
                 "the seed's Fig. 11: --volumes are injected along each EV's static route, over --background-vph");
   cmd->add_option("--background-vph", o->background_vph, "with --inject-on-route: background vehicles/hour")->capture_default_str();
-  cmd->callback([o, signals, routings, emit_jobs, collect, end_s, libsumo, route_only] {
+  cmd->add_option("--ev-vclass", o->ev_vclass, "the EV's SUMO vehicle class")->capture_default_str();
+  cmd->add_flag("--rebuild-net", o->rebuild_net,
+                "a net written by a newer netconvert is converted with the installed one into the output directory");
+  auto keep_going = std::make_shared<bool>(false);
+  cmd->add_flag("--keep-going", *keep_going, "exit 0 even when runs failed (they are rows with status failed either way)");
+  // Every run is a row; a failed one makes the command fail unless --keep-going.
+  const auto report = [o, keep_going](const sim::ExperimentTables& tables) {
+    std::ifstream md(o->out_dir / "sumo_summary.md");
+    std::cout << md.rdbuf() << "\nOutput in " << o->out_dir.string() << "\n";
+    if (!tables.failures.empty() && !*keep_going) {
+      throw std::runtime_error(std::to_string(tables.failures.size()) + " run(s) did not complete; they are listed in " +
+                       (o->out_dir / "sumo_summary.md").string() + " (give --keep-going to exit 0 all the same)");
+    }
+  };
+  cmd->callback([o, signals, routings, emit_jobs, collect, end_s, libsumo, route_only, report] {
     if (!emit_jobs->empty() && !collect->empty()) throw UsageError("--emit-jobs and --collect are two steps: give one");
     if (!collect->empty()) {
       std::vector<std::filesystem::path> dirs(collect->begin(), collect->end());
-      sim::collect_sumo_experiment(dirs, o->out_dir);
-      std::ifstream md(o->out_dir / "sumo_summary.md");
-      std::cout << md.rdbuf() << "\nOutput in " << o->out_dir.string() << "\n";
+      report(sim::collect_sumo_experiment(dirs, o->out_dir));
       return;
+    }
+    if (!maps::sumo_class_bit(o->ev_vclass)) {
+      throw UsageError("--ev-vclass must be a SUMO vehicle class (emergency, passenger, bus, ...), got '" + o->ev_vclass + "'");
     }
     o->backend = *libsumo ? sim::SumoBackend::libsumo : sim::SumoBackend::traci;
     o->vicinity = !*route_only;
@@ -312,9 +340,7 @@ void register_sumo_experiment(CLI::App& experiment) {
                 << " --out " << o->out_dir.string() << "\n";
       return;
     }
-    sim::run_sumo_experiment(*o);
-    std::ifstream md(o->out_dir / "sumo_summary.md");
-    std::cout << md.rdbuf() << "\nOutput in " << o->out_dir.string() << "\n";
+    report(sim::run_sumo_experiment(*o));
   });
 }
 

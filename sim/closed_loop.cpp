@@ -36,7 +36,7 @@ std::string as_string(const libsumo::TraCIResults& r, int var) {
   return {};
 }
 
-void write_ev_types(const std::filesystem::path& file, double vmax_mps) {
+void write_ev_types(const std::filesystem::path& file, double vmax_mps, const std::string& vclass) {
   std::ofstream out(file, std::ios::trunc);
   // The EV drives at the speed limit (speedFactor 1), like the planner's cost model, up to vmax.
   // The bluelight type may pass red lights slowly, as SUMO users configure it. With Corridor's
@@ -45,18 +45,18 @@ void write_ev_types(const std::filesystem::path& file, double vmax_mps) {
   // device still lets it pass a red by design, and SUMO's other drivers do not yield to it there.
   out << fmt::format(
       "<additional>\n"
-      "  <vType id=\"ev\" vClass=\"emergency\" guiShape=\"emergency\" color=\"1,0,0\" maxSpeed=\"{0:.3f}\" "
+      "  <vType id=\"ev\" vClass=\"{1}\" guiShape=\"emergency\" color=\"1,0,0\" maxSpeed=\"{0:.3f}\" "
       "speedFactor=\"1\" speedDev=\"0\"/>\n"
-      "  <vType id=\"ev_bluelight\" vClass=\"emergency\" guiShape=\"emergency\" color=\"0,0,1\" maxSpeed=\"{0:.3f}\" "
+      "  <vType id=\"ev_bluelight\" vClass=\"{1}\" guiShape=\"emergency\" color=\"0,0,1\" maxSpeed=\"{0:.3f}\" "
       "speedFactor=\"1\" speedDev=\"0\" jmDriveAfterRedTime=\"300\" jmDriveRedSpeed=\"5.56\">\n"
       "    <param key=\"has.bluelight.device\" value=\"true\"/>\n"
       "  </vType>\n"
-      "  <vType id=\"ev_bluelight_preempted\" vClass=\"emergency\" guiShape=\"emergency\" color=\"1,0,1\" "
+      "  <vType id=\"ev_bluelight_preempted\" vClass=\"{1}\" guiShape=\"emergency\" color=\"1,0,1\" "
       "maxSpeed=\"{0:.3f}\" speedFactor=\"1\" speedDev=\"0\">\n"
       "    <param key=\"has.bluelight.device\" value=\"true\"/>\n"
       "  </vType>\n"
       "</additional>\n",
-      vmax_mps);
+      vmax_mps, vclass);
   if (!out) throw SimError("cannot write " + file.string());
 }
 
@@ -106,10 +106,11 @@ SumoLaunch launch_for(const SumoScenario& scenario, const ClosedLoopConfig& conf
   SumoLaunch launch;
   launch.net = scenario.net_file;
   launch.scale = config.demand_scale;
-  if (!config.background_routes.empty()) launch.routes.push_back(config.background_routes);
   std::error_code ec;
   if (scenario.config) {
-    launch.config = scenario.config->file;
+    launch.user_options = scenario.config->options;
+    launch.user_dir = scenario.config->file.parent_path();
+    launch.routes = scenario.config->route_files;
     // The scenario's additional files are copied into the run directory, so that the outputs they
     // declare (detector files, relative to the additional file) land there and not beside the
     // user's files.
@@ -121,11 +122,12 @@ SumoLaunch launch_for(const SumoScenario& scenario, const ClosedLoopConfig& conf
       if (ec) throw SimError("cannot copy " + file.string() + " into " + inputs.string() + ": " + ec.message());
       launch.additional.push_back(copy);
     }
-    for (const auto& [option, value] : scenario.config->outputs) {
-      if (option == "tripinfo-output") continue;  // the run's own, below
-      launch.options.emplace_back(option, (config.out_dir / (config.run_name + "." + std::filesystem::path(value).filename().string())).string());
-    }
+    // The configuration's own outputs go to the run directory, never beside the user's files.
+    launch.redirect_output = [dir = config.out_dir, run = config.run_name](const std::string&, const std::string& value) {
+      return (dir / (run + "." + std::filesystem::path(value).filename().string())).string();
+    };
   }
+  if (!config.background_routes.empty()) launch.routes.push_back(config.background_routes);
   if (config.inject_on_route_vph > 0.0) {
     const auto& g = scenario.graph.graph;
     const planner::CostOverlay free_flow(g);
@@ -149,14 +151,16 @@ SumoLaunch launch_for(const SumoScenario& scenario, const ClosedLoopConfig& conf
     launch.routes.push_back(file);
   }
   const auto types = config.out_dir / (config.run_name + ".ev_types.add.xml");
-  write_ev_types(types, config.ev_vmax_kmh / 3.6);
+  write_ev_types(types, config.ev_vmax_kmh / 3.6, scenario.ev_vclass);
   launch.additional.push_back(types);
   launch.tripinfo = config.out_dir / (config.run_name + ".tripinfo.xml");
   launch.log = config.out_dir / (config.run_name + ".sumo.log");
   launch.end_s = config.end_s;
   launch.seed = config.seed;
+  launch.run_config = config.out_dir / (config.run_name + ".sumocfg");
   std::filesystem::remove(launch.tripinfo, ec);
   std::filesystem::remove(launch.log, ec);
+  write_launch_config(launch, scenario.sumo_options);
   return launch;
 }
 

@@ -17,16 +17,20 @@ struct LibsumoApi {
   using TrafficLight = libsumo::TrafficLight;
 };
 
-// Starts SUMO in-process with SUMO's messages sent to the run's log, as the socket bridge does.
+// Starts SUMO in-process on the run's configuration.
 class LibsumoSession {
  public:
   explicit LibsumoSession(const SumoLaunch& launch) {
-    std::vector<std::string> cmd = sumo_command(launch, std::nullopt);
-    cmd.insert(cmd.end(), {"--log", launch.log.string()});
+    // The run's configuration sends SUMO's messages to the run's log, as the socket bridge does.
+    const std::vector<std::string> cmd = sumo_command(launch, std::nullopt);
     try {
       libsumo::Simulation::start(cmd);
     } catch (const std::exception& e) {
-      throw SimError(std::string("libsumo could not start the simulation: ") + e.what() + "; see " + launch.log.string());
+      std::error_code ec;
+      const bool logged = std::filesystem::file_size(launch.log, ec) > 0 && !ec;
+      throw SimError(std::string("libsumo could not start the simulation: ") + e.what() + "; " +
+                     (logged ? "see " + launch.log.string() : "SUMO wrote its reason on standard error") + " (configuration " +
+                     launch.run_config.string() + ")");
     }
     open_ = true;
   }

@@ -42,7 +42,8 @@ inline constexpr preemption::MissionId kMission = 1;
 
 double as_double(const libsumo::TraCIResults& r, int var);
 std::string as_string(const libsumo::TraCIResults& r, int var);
-void write_ev_types(const std::filesystem::path& file, double vmax_mps);
+// The EV's vehicle types, of SUMO class `vclass`.
+void write_ev_types(const std::filesystem::path& file, double vmax_mps, const std::string& vclass);
 // The vehicle type write_ev_types defines for a signal strategy.
 inline const char* ev_type(EvSignals s) {
   switch (s) {
@@ -193,7 +194,8 @@ ClosedLoopResult run_loop(const SumoScenario& scenario, const ClosedLoopConfig& 
 
   ApiTrafficLights<Api> lights_api;
   // One controller and one engine entry per light, whichever approach a claim comes from.
-  SumoSignalController controller(scenario.signal_plans, scenario.sumo_plan_of, scenario.tls_phases, lights_api);
+  SumoSignalController controller(scenario.signal_plans, scenario.sumo_plan_of, scenario.tls_phases, lights_api,
+                                  scenario.actuated_tls);
   preemption::PreemptionConfig preemption_config;
   preemption_config.vicinity.enabled = config.vicinity;
   preemption::PreemptionEngine engine(g, scenario.signal_plans, controller, preemption_config);

@@ -1,6 +1,7 @@
 #include "sim/scenario_builder.hpp"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include <cstdlib>
 #include <fstream>
@@ -24,8 +25,16 @@ void prepare(const std::filesystem::path& dir) {
   if (ec) throw SimError("cannot create the scenario directory '" + dir.string() + "': " + ec.message());
 }
 
-// A net newer than the installed SUMO is refused before SUMO misreads it.
-void check_net_readable(const std::filesystem::path& net) {
+bool up_to_date(const std::filesystem::path& out, const std::filesystem::path& input) {
+  std::error_code ec;
+  return std::filesystem::exists(out) && std::filesystem::file_size(out, ec) > 0 &&
+         (input.empty() || std::filesystem::last_write_time(out) >= std::filesystem::last_write_time(input));
+}
+
+// A net newer than the installed SUMO is refused before SUMO misreads it, or converted with the
+// installed netconvert into `dir` where the options allow: returns the net to run.
+std::filesystem::path readable_net(const std::filesystem::path& net, const std::filesystem::path& dir, const NetOptions& options,
+                                   std::filesystem::path& rebuilt_from) {
   std::string version;
   try {
     version = maps::read_sumo_net_version(net);
@@ -33,13 +42,29 @@ void check_net_readable(const std::filesystem::path& net) {
     throw SimError(e.what());
   }
   // Old nets carry no version, and SUMO reads them: no need to ask SUMO for its own.
-  if (!version.empty()) check_net_version(net, version, installed_sumo_version());
-}
-
-bool up_to_date(const std::filesystem::path& out, const std::filesystem::path& input) {
-  std::error_code ec;
-  return std::filesystem::exists(out) && std::filesystem::file_size(out, ec) > 0 &&
-         (input.empty() || std::filesystem::last_write_time(out) >= std::filesystem::last_write_time(input));
+  if (version.empty()) return net;
+  const std::string sumo = installed_sumo_version();
+  try {
+    check_net_version(net, version, sumo);
+    return net;
+  } catch (const SimError& e) {
+    if (!options.rebuild_net) throw SimError(std::string(e.what()) + ", or give --rebuild-net to convert it into the work directory");
+  }
+  prepare(dir);
+  std::string stem = net.filename().string();
+  if (stem.ends_with(".net.xml")) stem.resize(stem.size() - 8);
+  const auto out = dir / (stem + ".rebuilt.net.xml");
+  rebuilt_from = net;
+  if (up_to_date(out, net)) {
+    spdlog::warn("event=net_rebuilt net={} net_version={} sumo={} out={} detail=\"converted earlier with the installed netconvert\"",
+                 net.string(), version, sumo, out.string());
+    return out;
+  }
+  spdlog::warn("event=net_rebuilt net={} net_version={} sumo={} out={} detail=\"written by a newer netconvert; converted with "
+               "the installed one, the original is left as it is\"",
+               net.string(), version, sumo, out.string());
+  run_tool({"netconvert", "--sumo-net-file", net.string(), "-o", out.string()}, dir / (stem + ".rebuild.log"));
+  return out;
 }
 
 }  // namespace
@@ -51,7 +76,7 @@ ScenarioNet build_grid_net(const std::filesystem::path& dir, const GridSpec& spe
   }
   prepare(dir);
   const std::string name = fmt::format("grid{}x{}", spec.blocks, spec.blocks);
-  ScenarioNet net{name, dir, dir / (name + ".net.xml"), std::nullopt};
+  ScenarioNet net{name, dir, dir / (name + ".net.xml"), std::nullopt, {}};
   if (up_to_date(net.net, {})) return net;
   run_tool({"netgenerate", "--grid", "--grid.number", std::to_string(spec.blocks), "--grid.length",
             fmt::format("{}", spec.block_m), "--default.lanenumber", std::to_string(spec.lanes), "--default.speed",
@@ -104,7 +129,7 @@ std::string nema_tl_logic(const std::string& tls, const maps::SignalPlan& plan,
 ScenarioNet build_nema_grid_net(const std::filesystem::path& dir, const GridSpec& spec) {
   const ScenarioNet base = build_grid_net(dir, spec);
   const std::string name = fmt::format("nema_grid{}x{}", spec.blocks, spec.blocks);
-  ScenarioNet net{name, dir, dir / (name + ".net.xml"), std::nullopt};
+  ScenarioNet net{name, dir, dir / (name + ".net.xml"), std::nullopt, {}};
   if (up_to_date(net.net, base.net)) return net;
   const maps::SumoNet sumo = maps::read_sumo_net(base.net);
   std::string tll = "<tlLogics>\n";
@@ -149,7 +174,7 @@ ScenarioNet build_osm_net(const std::filesystem::path& dir, const std::filesyste
   prepare(dir);
   std::string name = osm_file.filename().string();
   name = name.substr(0, name.find('.'));
-  ScenarioNet net{name, dir, dir / (name + ".net.xml"), std::nullopt};
+  ScenarioNet net{name, dir, dir / (name + ".net.xml"), std::nullopt, {}};
   if (up_to_date(net.net, osm_file)) return net;
   std::filesystem::path input = osm_file;
   if (osm_file.extension() == ".pbf") {
@@ -163,7 +188,7 @@ ScenarioNet build_osm_net(const std::filesystem::path& dir, const std::filesyste
   return net;
 }
 
-ScenarioNet build_scenario_net(const std::string& scenario, const std::filesystem::path& dir) {
+ScenarioNet build_scenario_net(const std::string& scenario, const std::filesystem::path& dir, const NetOptions& options) {
   if (scenario == "grid") return build_grid_net(dir, GridSpec{});
   if (scenario == "nema-grid") return build_nema_grid_net(dir, GridSpec{});
   const std::filesystem::path file(scenario);
@@ -174,14 +199,17 @@ ScenarioNet build_scenario_net(const std::string& scenario, const std::filesyste
   const std::string name = file.filename().string();
   if (name.size() > 8 && name.ends_with(".sumocfg")) {
     SumoConfig config = read_sumo_config(file);
-    check_net_readable(config.net_file);
+    ScenarioNet net{name.substr(0, name.size() - 8), dir, {}, std::nullopt, {}};
+    net.net = readable_net(config.net_file, dir, options, net.rebuilt_from);
     prepare(dir);
-    return ScenarioNet{name.substr(0, name.size() - 8), dir, config.net_file, std::move(config)};
+    net.config = std::move(config);
+    return net;
   }
   if (name.size() > 8 && name.ends_with(".net.xml")) {
-    check_net_readable(file);
+    ScenarioNet net{name.substr(0, name.size() - 8), dir, {}, std::nullopt, {}};
+    net.net = std::filesystem::absolute(readable_net(std::filesystem::absolute(file), dir, options, net.rebuilt_from));
     prepare(dir);
-    return ScenarioNet{name.substr(0, name.size() - 8), dir, std::filesystem::absolute(file), std::nullopt};
+    return net;
   }
   if (name.ends_with(".osm") || name.ends_with(".osm.gz") || name.ends_with(".pbf")) return build_osm_net(dir, file);
   throw SimError("'" + scenario + "' is neither a SUMO .net.xml nor an OSM file (.osm, .osm.gz, .osm.pbf)");

@@ -22,8 +22,18 @@ struct ScenarioNet {
   std::string name;  // "grid", or the OSM file's or configuration's stem
   std::filesystem::path dir;
   std::filesystem::path net;
-  // A user's scenario (.sumocfg): its own demand is the background traffic, and SUMO runs it with -c.
+  // A user's scenario (.sumocfg): its own demand is the background traffic, and each run's SUMO
+  // configuration is derived from it.
   std::optional<SumoConfig> config;
+  // The user's net, when `net` is its conversion by the installed netconvert (NetOptions).
+  std::filesystem::path rebuilt_from;
+};
+
+struct NetOptions {
+  // A net written by a newer netconvert than the installed SUMO's is converted with the installed
+  // netconvert into the scenario directory (the user's file is left as it is); without this it is
+  // refused, since SUMO reads such a net without a word and misreads what changed.
+  bool rebuild_net = false;
 };
 
 // A grid like the seed paper's: two lanes per direction, a traffic light at every junction.
@@ -39,11 +49,12 @@ ScenarioNet build_nema_grid_net(const std::filesystem::path& dir, const GridSpec
 // A .pbf is first converted to .osm with osmium-tool, since netconvert does not read PBF.
 ScenarioNet build_osm_net(const std::filesystem::path& dir, const std::filesystem::path& osm_file);
 
-// "grid" (the default grid), "nema-grid" (the same with NEMA programs), a user's SUMO configuration (.sumocfg), a SUMO .net.xml used as it
-// is, or an OSM file (.osm, .osm.gz, .pbf). A configuration's or net's files are read where they
-// are and never written; `dir` receives what runs produce. Throws SimError for a missing or
-// unusable file, and for a net newer than the installed SUMO.
-ScenarioNet build_scenario_net(const std::string& scenario, const std::filesystem::path& dir);
+// "grid" (the default grid), "nema-grid" (the same with NEMA programs), a user's SUMO configuration
+// (.sumocfg), a SUMO .net.xml used as it is, or an OSM file (.osm, .osm.gz, .pbf). A
+// configuration's or net's files are read where they are and never written; `dir` receives what
+// runs produce. Throws SimError for a missing or unusable file, and for a net newer than the
+// installed SUMO unless options.rebuild_net.
+ScenarioNet build_scenario_net(const std::string& scenario, const std::filesystem::path& dir, const NetOptions& options = {});
 
 struct DemandSpec {
   double vehicles_per_hour = 400.0;

@@ -23,25 +23,41 @@ std::atomic<int> bridge_counter{0};
 
 }  // namespace
 
-std::vector<std::string> sumo_command(const SumoLaunch& launch, std::optional<int> port) {
-  std::vector<std::string> cmd{launch.sumo_binary};
-  if (launch.config.empty()) {
-    cmd.insert(cmd.end(), {"-n", launch.net.string()});
-  } else {
-    cmd.insert(cmd.end(), {"-c", launch.config.string()});
-  }
-  if (launch.scale != 1.0) cmd.insert(cmd.end(), {"--scale", fmt::format("{:g}", launch.scale)});
-  for (const auto& [name, value] : launch.options) cmd.insert(cmd.end(), {"--" + name, value});
-  if (!launch.routes.empty()) cmd.insert(cmd.end(), {"-r", join_paths(launch.routes)});
-  if (!launch.additional.empty()) cmd.insert(cmd.end(), {"-a", join_paths(launch.additional)});
+void write_launch_config(const SumoLaunch& launch, const SumoOptionCatalog& catalog) {
+  std::vector<std::pair<std::string, std::string>> owned{
+      {"net-file", launch.net.string()},
+      {"additional-files", join_paths(launch.additional)},
+      {"scale", fmt::format("{:g}", launch.scale)},
+      {"log", launch.log.string()},
+      {"step-length", fmt::format("{:g}", launch.step_length_s)},
+      {"end", fmt::format("{:g}", launch.end_s)},
+      {"seed", std::to_string(launch.seed)},
+      {"random", "false"},
+      {"output-prefix", ""},  // it would move the run's own outputs too
+      {"no-step-log", "true"},
+      {"duration-log.disable", "true"},
+      {"collision.action", "warn"},
+      // TraCI's port is the run's: the command line gives it, once (sumo_command).
+      {"remote-port", "0"},
+      {"num-clients", "1"},
+  };
+  if (!launch.routes.empty()) owned.emplace_back("route-files", join_paths(launch.routes));
   if (!launch.tripinfo.empty()) {
-    cmd.insert(cmd.end(), {"--tripinfo-output", launch.tripinfo.string(), "--tripinfo-output.write-unfinished", "true"});
+    owned.emplace_back("tripinfo-output", launch.tripinfo.string());
+    owned.emplace_back("tripinfo-output.write-unfinished", "true");
   }
-  cmd.insert(cmd.end(), {"--step-length", fmt::format("{:g}", launch.step_length_s), "--end", fmt::format("{:g}", launch.end_s),
-                         "--seed", std::to_string(launch.seed), "--no-step-log", "true", "--duration-log.disable", "true",
-                         "--collision.action", "warn"});
   // A user's scenario keeps its own teleport and route-error settings.
-  if (launch.config.empty()) cmd.insert(cmd.end(), {"--time-to-teleport", "300", "--ignore-route-errors", "true"});
+  if (launch.user_options.empty()) {
+    owned.emplace_back("time-to-teleport", "300");
+    owned.emplace_back("ignore-route-errors", "true");
+  }
+  const auto keep = [](const std::string&, const std::string& value) { return value; };
+  write_run_config(launch.run_config, catalog, launch.user_options, launch.user_dir, owned,
+                   launch.redirect_output ? launch.redirect_output : keep);
+}
+
+std::vector<std::string> sumo_command(const SumoLaunch& launch, std::optional<int> port) {
+  std::vector<std::string> cmd{launch.sumo_binary, "-c", launch.run_config.string()};
   if (port) cmd.insert(cmd.end(), {"--remote-port", std::to_string(*port), "--num-clients", "1"});
   return cmd;
 }

@@ -4,24 +4,29 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "sim/process.hpp"
+#include "sim/sumo_options.hpp"
 
 namespace corridor::sim {
 
 struct SumoLaunch {
-  // A user's configuration, run with -c: its net, demand, programs and options stand, and only the
-  // options below override them. Empty: the net and routes below.
-  std::filesystem::path config;
+  // The configuration SUMO reads for this run (write_launch_config writes it): the user's options,
+  // if the scenario is a user's, with the run's own below set in it once.
+  std::filesystem::path run_config;
+  // A user's scenario: its options as its .sumocfg holds them, and the directory that file is in.
+  std::vector<SumoOptionValue> user_options;
+  std::filesystem::path user_dir;
+  // Where a user's output option's file goes (option, value -> path in the run directory).
+  std::function<std::string(const std::string&, const std::string&)> redirect_output;
   double scale = 1.0;  // SUMO's --scale: the demand's multiplier
-  // Further options set for this run, such as a configuration's outputs sent to the run directory.
-  std::vector<std::pair<std::string, std::string>> options;
   std::filesystem::path net;
-  std::vector<std::filesystem::path> routes;
+  std::vector<std::filesystem::path> routes;  // the user's, then the run's own
   std::vector<std::filesystem::path> additional;
   std::filesystem::path tripinfo;  // written at the end; empty for none
   std::filesystem::path log;       // SUMO's own output
@@ -30,6 +35,9 @@ struct SumoLaunch {
   std::uint64_t seed = 1;
   std::string sumo_binary = "sumo";
 };
+
+// Writes launch.run_config. Throws SimError for an option of the user's that SUMO does not know.
+void write_launch_config(const SumoLaunch& launch, const SumoOptionCatalog& catalog);
 
 // The sumo command line for a launch; with a port, SUMO waits there for one TraCI client.
 std::vector<std::string> sumo_command(const SumoLaunch& launch, std::optional<int> port);

@@ -174,6 +174,7 @@ SumoConfig read_sumo_config(const std::filesystem::path& file) {
     return *t;
   };
   for (const auto& [raw_name, value] : st.options) {
+    c.options.push_back({raw_name, value});
     const std::string name = canonical(raw_name);
     if (name == "net-file") {
       c.net_file = resolve(name, value);

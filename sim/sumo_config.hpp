@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "sim/sumo_options.hpp"
+
 namespace corridor::sim {
 
 // A lane-area (e2) detector of the user's additional files: what SUMO's LaneArea API reads.
@@ -21,6 +23,9 @@ struct LaneAreaDetector {
 
 struct SumoConfig {
   std::filesystem::path file;  // absolute
+  // Every option the file sets, as it sets it (a synonym stays a synonym), in file order: a run's
+  // own configuration is derived from these (sumo_options.hpp).
+  std::vector<SumoOptionValue> options;
   std::filesystem::path net_file;
   std::vector<std::filesystem::path> route_files;
   std::vector<std::filesystem::path> additional_files;

@@ -5,8 +5,9 @@
 // A matrix is planned once, then either run here (two at a time, each SUMO run in a forked child),
 // or emitted as one self-contained `corridor sim` command line per run for an existing engine (GNU
 // parallel, over SSH hosts, a Slurm array) and collected afterwards. Every run leaves the same
-// record file (`*.run.json`), and the outputs are always made from those records, so both ways
-// give the same tables.
+// record file (`*.run.json`), a failed one too, and the plan itself is kept beside them
+// (`runs/matrix.json`), so that a run whose process died is still a row. The outputs are always
+// made from those records, so both ways give the same tables.
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -18,6 +19,8 @@
 #include <vector>
 
 #include "sim/closed_loop.hpp"
+#include "sim/experiment_tables.hpp"
+#include "sim/run_record.hpp"
 
 namespace corridor::sim {
 
@@ -45,41 +48,14 @@ struct SumoExperimentOptions {
   bool inject_on_route = false;
   double background_vph = 400.0;
   std::uint32_t evs = 1;  // EVs per run (--evs): the further ones conflict with the first at its lights
-};
-
-// One run's identity and result: what `corridor sim --result FILE` writes and what is collected.
-struct RunRecord {
-  std::string scenario;
-  bool with_ev = true;
-  EvRouting routing = EvRouting::dynamic_route;
-  EvSignals signals = EvSignals::corridor;
-  // Generated background veh/h (0 for a scenario's own demand); with inject_on_route, the volume
-  // injected on the EV's static route.
-  double volume = 0.0;
-  bool inject_on_route = false;
-  double demand_scale = 1.0;  // SUMO's --scale
-  std::uint64_t seed = 1;
-  std::string ev_from;
-  std::string ev_to;
-  double ev_depart_s = 0.0;  // simulation time
-  bool vicinity = true;      // vicinity-aware preemption, or route-only
-  std::uint32_t evs = 1;
-  ClosedLoopResult result;
-};
-nlohmann::json to_json_record(const RunRecord& r);
-// Throws SimError naming `source` for a record that is not one.
-RunRecord record_from_json(const nlohmann::json& j, const std::string& source);
-
-struct ExperimentRow {
-  RunRecord run;
-  double baseline_time_loss_s;
-  [[nodiscard]] double others_delay_rel() const;
-  [[nodiscard]] double ev_time_s() const;  // travel time, or the time it was still driving
+  std::string ev_vclass = "emergency";  // the EV's SUMO vehicle class (--ev-vclass)
+  bool rebuild_net = false;             // convert a net newer than the installed SUMO (--rebuild-net)
 };
 
 // Runs the matrix here and writes sumo_runs.csv, sumo_summary.csv, sumo_summary.md and the plots
-// into out_dir. Returns the rows, sorted by demand, seed, routing and signals.
-std::vector<ExperimentRow> run_sumo_experiment(const SumoExperimentOptions& options);
+// into out_dir. Returns the rows, sorted by demand, seed, routing and signals, and the runs that
+// failed.
+ExperimentTables run_sumo_experiment(const SumoExperimentOptions& options);
 
 // Plans the matrix (nets and generated demand are built now, so that runs write only their own
 // directories) and writes one `corridor sim` command line per run to `jobs_file`. Paths are
@@ -87,14 +63,13 @@ std::vector<ExperimentRow> run_sumo_experiment(const SumoExperimentOptions& opti
 std::size_t emit_sumo_jobs(const SumoExperimentOptions& options, const std::filesystem::path& jobs_file,
                            const std::filesystem::path& corridor_binary);
 
-// Reads every *.run.json under `dirs` and writes the CSVs, the summary and the plots into out_dir.
-// Throws SimError when there is no record, when a run has no baseline, or when records disagree
-// on their scenario.
-std::vector<ExperimentRow> collect_sumo_experiment(const std::vector<std::filesystem::path>& dirs,
-                                                   const std::filesystem::path& out_dir);
+// Reads every *.run.json under `dirs`, and every run a matrix.json there planned (one without a
+// record is a failed row), and writes the CSVs, the summary and the plots into out_dir. Throws
+// SimError when there is no record at all, or when records disagree on their scenario.
+ExperimentTables collect_sumo_experiment(const std::vector<std::filesystem::path>& dirs, const std::filesystem::path& out_dir);
 
 // The same from a list of record files; a file that is missing or is not a record is listed in the
-// summary as a failed run and left out.
-std::vector<ExperimentRow> collect_run_files(std::vector<std::filesystem::path> files, const std::filesystem::path& out_dir);
+// summary as a failed run.
+ExperimentTables collect_run_files(std::vector<std::filesystem::path> files, const std::filesystem::path& out_dir);
 
 }  // namespace corridor::sim

@@ -5,7 +5,7 @@
 
 namespace corridor::sim {
 
-std::unique_ptr<SumoScenario> load_sumo_scenario(const ScenarioNet& scenario_net) {
+std::unique_ptr<SumoScenario> load_sumo_scenario(const ScenarioNet& scenario_net, const std::string& ev_vclass) {
   maps::SumoNet net = maps::read_sumo_net(scenario_net.net);
   if (scenario_net.config) {
     for (const auto& file : scenario_net.config->additional_files) {
@@ -15,15 +15,19 @@ std::unique_ptr<SumoScenario> load_sumo_scenario(const ScenarioNet& scenario_net
       }
     }
   }
-  maps::SumoGraph graph = maps::build_sumo_graph(net);
-  auto s = std::unique_ptr<SumoScenario>(new SumoScenario{scenario_net.name, scenario_net.dir, scenario_net.net,
-                                                          std::move(net), std::move(graph), {}, {}, {}, {}, {}, {},
-                                                          scenario_net.config});
+  maps::SumoGraph graph = maps::build_sumo_graph(net, ev_vclass);
+  auto s = std::unique_ptr<SumoScenario>(new SumoScenario{scenario_net.name, ev_vclass, scenario_net.dir, scenario_net.net,
+                                                          std::move(net), std::move(graph), {}, {}, {}, {}, {}, {}, {},
+                                                          scenario_net.config,
+                                                          SumoOptionCatalog::from_sumo("sumo", scenario_net.dir)});
   s->sumo_plans = maps::sumo_signal_plans(s->net);
   std::unordered_map<NodeId, std::size_t> tls_of;
   s->plans = maps::plans_by_node(s->graph, s->net, s->sumo_plans, &tls_of);
   for (const auto& [node, index] : tls_of) s->sumo_plan_of[node] = &s->sumo_plans[index];
-  for (const auto& logic : s->net.tl_logics) s->tls_phases[logic.id] = logic.phases;
+  for (const auto& logic : s->net.tl_logics) {
+    s->tls_phases[logic.id] = logic.phases;
+    if (logic.type == "actuated" || logic.type == "delay_based") s->actuated_tls.insert(logic.id);
+  }
   std::map<std::size_t, NodeId> key_of_tls;
   for (const auto& [node, index] : tls_of) {
     auto [it, fresh] = key_of_tls.emplace(index, node);

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <set>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -10,11 +11,13 @@
 #include "maps/sumo_graph.hpp"
 #include "maps/sumo_net.hpp"
 #include "sim/scenario_builder.hpp"
+#include "sim/sumo_options.hpp"
 
 namespace corridor::sim {
 
 struct SumoScenario {
   std::string name;
+  std::string ev_vclass = "emergency";  // the SUMO class the EV drives as, and the graph is built for
   std::filesystem::path dir;  // scenario files and run outputs
   std::filesystem::path net_file;
   maps::SumoNet net;
@@ -28,7 +31,9 @@ struct SumoScenario {
   std::unordered_map<NodeId, NodeId> signal_node;  // stop-line node -> its light's key in signal_plans
   std::unordered_map<NodeId, const maps::SumoSignalPlan*> sumo_plan_of;
   std::unordered_map<std::string, std::vector<maps::SumoTlPhase>> tls_phases;
+  std::set<std::string> actuated_tls;  // lights whose programs SUMO times itself
   std::optional<SumoConfig> config;  // a user's scenario: SUMO runs its configuration
+  SumoOptionCatalog sumo_options;    // the installed SUMO's options, for each run's configuration
 };
 
 // The light's key (signal_plans) of a stop-line node; the node itself when no light controls it.
@@ -39,7 +44,8 @@ struct SumoScenario {
 
 // Throws MapLoadError / SimError for an unreadable or unusable net. With a configuration, the
 // traffic-light programs of its additional files replace the net's (SUMO runs the last program
-// loaded for a light), so that the normal programs preemption restores are the scenario's own.
-std::unique_ptr<SumoScenario> load_sumo_scenario(const ScenarioNet& net);
+// loaded for a light), so that the normal programs preemption restores are the scenario's own. The
+// graph admits what SUMO admits for an EV of class `ev_vclass`: its routes are ones SUMO accepts.
+std::unique_ptr<SumoScenario> load_sumo_scenario(const ScenarioNet& net, const std::string& ev_vclass = "emergency");
 
 }  // namespace corridor::sim

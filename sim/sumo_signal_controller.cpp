@@ -53,7 +53,7 @@ std::string phase_state(const maps::Phase& phase) {
 SumoSignalController::SumoSignalController(const std::unordered_map<NodeId, maps::SignalPlan>& plans,
                                            const std::unordered_map<NodeId, const maps::SumoSignalPlan*>& sumo,
                                            const std::unordered_map<std::string, std::vector<maps::SumoTlPhase>>& sumo_phases,
-                                           TrafficLightApi& api)
+                                           TrafficLightApi& api, const std::set<std::string>& actuated)
     : api_(api) {
   for (const auto& [node, plan] : plans) {
     const auto s = sumo.find(node);
@@ -66,6 +66,7 @@ SumoSignalController::SumoSignalController(const std::unordered_map<NodeId, maps
     const auto phases = sumo_phases.find(l.tls);
     if (phases == sumo_phases.end() || phases->second.empty()) throw SimError("traffic light '" + l.tls + "' has no phases");
     l.sumo_phases = phases->second;
+    l.actuated = actuated.contains(l.tls);
     const std::size_t n = plan.movements.size();
     l.allowed_together.assign(n * n, 0);
     for (const auto& p : l.sumo_phases) {
@@ -332,6 +333,46 @@ std::optional<double> SumoSignalController::green_start_s(NodeId node, std::size
   const std::string s = api_.state(l.tls);
   if (movement >= s.size() || !is_green(s[movement])) return std::nullopt;
   return now_s_ - api_.spent_s(l.tls);
+}
+
+std::vector<preemption::ProgramInterval> SumoSignalController::program_forecast(NodeId node, double now_s, double horizon_s) const {
+  const Light& l = light(node);
+  std::vector<preemption::ProgramInterval> out;
+  if (l.stage != Stage::program) return out;
+  const int p = api_.phase(l.tls);
+  if (p < 0 || static_cast<std::size_t>(p) >= l.sumo_phases.size()) return out;
+  const auto interval = [&](const maps::SumoTlPhase& ph, double start, double end) {
+    preemption::ProgramInterval iv;
+    iv.start_s = start;
+    iv.end_s = end;
+    iv.green.assign(ph.state.size(), 0);
+    for (std::size_t i = 0; i < ph.state.size(); ++i) iv.green[i] = is_green(ph.state[i]) ? 1 : 0;
+    iv.clearance = has_yellow(ph.state) || !has_green(ph.state);
+    const double min_green = ph.min_duration_s > 0 ? std::min(ph.min_duration_s, ph.duration_s) : std::min(5.0, ph.duration_s);
+    iv.min_green_end_s = start + min_green;
+    return iv;
+  };
+  std::size_t k = static_cast<std::size_t>(p);
+  const maps::SumoTlPhase& on_show = l.sumo_phases[k];
+  const double spent = api_.spent_s(l.tls);
+  if (l.actuated) {
+    // SUMO may end it as soon as its minimum duration is served, and times what follows itself.
+    const double min_end = now_s + std::max(0.0, (on_show.min_duration_s > 0 ? on_show.min_duration_s : on_show.duration_s) - spent);
+    out.push_back(interval(on_show, now_s, min_end));
+    out.back().min_green_end_s = min_end;
+    return out;
+  }
+  double t = now_s + std::max(0.0, on_show.duration_s - spent);
+  out.push_back(interval(on_show, now_s, t));
+  out.back().min_green_end_s = now_s - spent + (out.back().min_green_end_s - now_s);
+  // Bounded: a horizon of minutes and programs of a few dozen phases.
+  for (int guard = 0; t < now_s + horizon_s && guard < 2000; ++guard) {
+    k = (k + 1) % l.sumo_phases.size();
+    const double d = std::max(l.sumo_phases[k].duration_s, 0.1);
+    out.push_back(interval(l.sumo_phases[k], t, t + d));
+    t += d;
+  }
+  return out;
 }
 
 std::size_t SumoSignalController::lights_taken_over() const {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <optional>
+#include <set>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -29,10 +30,12 @@ class TrafficLightApi {
 class SumoSignalController final : public preemption::SignalController {
  public:
   // `plans` are keyed by node and must outlive the controller; `sumo` gives each node's light.
+  // `actuated` names the lights whose programs SUMO times itself (actuated, delay_based): their
+  // phases' lengths are not known ahead.
   SumoSignalController(const std::unordered_map<NodeId, maps::SignalPlan>& plans,
                        const std::unordered_map<NodeId, const maps::SumoSignalPlan*>& sumo,
                        const std::unordered_map<std::string, std::vector<maps::SumoTlPhase>>& sumo_phases,
-                       TrafficLightApi& api);
+                       TrafficLightApi& api, const std::set<std::string>& actuated = {});
 
   // Advances yellow and all-red stages; call every simulation step.
   void update(double now_s);
@@ -43,6 +46,10 @@ class SumoSignalController final : public preemption::SignalController {
   [[nodiscard]] double remaining_min_green_s(NodeId node, double now_s) const override;
   [[nodiscard]] std::optional<std::size_t> current_phase(NodeId node) const override;
   [[nodiscard]] std::optional<double> green_start_s(NodeId node, std::size_t movement) const override;
+  // SUMO's program from its phase on show: every phase of a fixed program, only the shortest the
+  // phase on show can be of an actuated one.
+  [[nodiscard]] std::vector<preemption::ProgramInterval> program_forecast(NodeId node, double now_s,
+                                                                          double horizon_s) const override;
 
   // Breaches of the safety rules in the states this controller set; empty when all held.
   [[nodiscard]] const std::vector<std::string>& violations() const { return violations_; }
@@ -71,6 +78,7 @@ class SumoSignalController final : public preemption::SignalController {
     bool release_pending = false;
     int resume_sumo_phase = 0;
     bool taken_over = false;
+    bool actuated = false;
     // Audit: when each link took its current light.
     std::vector<double> since_s;
   };

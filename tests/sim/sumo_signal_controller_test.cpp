@@ -202,6 +202,38 @@ TEST(SumoSignalController, ChangingTheTargetDuringTheAllRedKeepsTheAllRed) {
   EXPECT_TRUE(c.violations().empty()) << c.violations().front();
 }
 
+// What SUMO's program will show, from its phase on show: a fixed program phase by phase, an
+// actuated one only as far as the shortest the phase on show can be; nothing while held.
+TEST(SumoSignalController, ForecastsAFixedProgramAndOnlyTheShortestActuatedPhase) {
+  Fixture f;
+  FakeLights api(f.phases["J"]);
+  SumoSignalController c(f.plans, f.sumo_of, f.phases, api);
+  api.advance(10.0);
+  const auto forecast = c.program_forecast(f.node, 10.0, 100.0);
+  ASSERT_GE(forecast.size(), 4u);
+  EXPECT_DOUBLE_EQ(forecast[0].start_s, 10.0);
+  EXPECT_DOUBLE_EQ(forecast[0].end_s, 30.0);
+  EXPECT_EQ(forecast[0].green, (std::vector<std::uint8_t>{1, 1, 0, 0}));
+  EXPECT_FALSE(forecast[0].clearance);
+  EXPECT_DOUBLE_EQ(forecast[0].min_green_end_s, 5.0);  // the phase began at 0 s
+  EXPECT_TRUE(forecast[1].clearance);
+  EXPECT_DOUBLE_EQ(forecast[1].end_s, 33.0);
+  EXPECT_EQ(forecast[2].green, (std::vector<std::uint8_t>{0, 0, 1, 1}));
+  EXPECT_DOUBLE_EQ(forecast[2].end_s, 63.0);
+  EXPECT_GE(forecast.back().end_s, 110.0);
+  c.hold(f.node, f.plans[f.node].phases[1], 10.0);
+  EXPECT_TRUE(c.program_forecast(f.node, 10.0, 100.0).empty());
+
+  auto phases = f.phases;
+  phases["J"][0].min_duration_s = 12.0;
+  FakeLights actuated_api(phases["J"]);
+  SumoSignalController actuated(f.plans, f.sumo_of, phases, actuated_api, {"J"});
+  actuated_api.advance(10.0);
+  const auto short_forecast = actuated.program_forecast(f.node, 10.0, 100.0);
+  ASSERT_EQ(short_forecast.size(), 1u);
+  EXPECT_DOUBLE_EQ(short_forecast[0].end_s, 12.0);
+}
+
 TEST(SumoSignalController, RejectsAPlanWithoutItsLight) {
   Fixture f;
   FakeLights api(f.phases["J"]);
