@@ -91,7 +91,7 @@ void run_route(const RouteOptions& o) {
   if (o.signals != "flat") {
     // Each movement through a signal waits by its green share in the intersection's normal program
     // (a SUMO net's own plans, else the default NEMA plan from its legs), as the server charges it.
-    preemption::set_signal_costs(overlay, graph, maps::signal_plans_for(o.map.map_file, graph),
+    preemption::set_signal_costs(overlay, graph, maps::signal_plans_for(o.map.map_file, graph).plans,
                                  o.signals == "preempted" ? preemption::SignalCostRule::preempted
                                                           : preemption::SignalCostRule::normal);
   }

@@ -34,6 +34,7 @@ struct ServeOptions {
   int repair_priority = 0;
   int background_nice = 10;
   bool demo = false;
+  bool route_only = false;
   server::PlannerGraph planner_graph = server::PlannerGraph::automatic;
 };
 
@@ -129,6 +130,9 @@ void run_serve(const ServeOptions& o) {
   dispatch.background_nice = o.background_nice;
   limits.io_nice = o.background_nice;
   dispatch.planner_graph = o.planner_graph;
+  // Vicinity-aware preemption: the detectors' queues (POST /v1/signals/{id}/counts with queue_m)
+  // start holds early enough to clear them; without detector reports it is route-only.
+  dispatch.preemption.vicinity.enabled = !o.route_only;
   server::DispatchService service(graph, maps::signal_plans_for(map_file, graph), dispatch, &store, now());
   std::vector<server::StaticAsset> console;
   for (const auto& f : web::embedded_files()) {
@@ -221,6 +225,8 @@ void register_serve_command(CLI::App& app) {
       ->check(CLI::Range(0, 19))
       ->capture_default_str();
   add_planner_graph_option(*cmd, o->planner_graph);
+  cmd->add_flag("--route-only", o->route_only,
+                "preempt from the vehicle's predicted arrival alone, without the vicinity rules that read detectors' queues");
   cmd->add_flag("--demo", o->demo,
                  "drive simulated vehicles along their missions' routes, and now and then congest a route ahead");
   cmd->callback([o] { run_serve(*o); });

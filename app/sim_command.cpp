@@ -173,7 +173,7 @@ void run_sim(const SimOptions& o) {
   record.ev_from = c.ev_from;
   record.ev_to = c.ev_to;
   record.ev_depart_s = c.ev_depart_s;
-  record.vicinity = c.vicinity && o.server.empty();  // the server's engine runs route-only
+  record.vicinity = c.vicinity;  // through a server, its own setting (serve --route-only)
   record.evs = o.evs;
   if (!net.rebuilt_from.empty()) {
     std::cerr << "corridor sim: " << net.rebuilt_from.string() << " was written by a newer netconvert; this run uses its "

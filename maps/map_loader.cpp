@@ -33,15 +33,14 @@ bool is_sumo_net(const std::filesystem::path& file) {
   return name.size() > 8 && name.ends_with(".net.xml");
 }
 
-std::unordered_map<NodeId, SignalPlan> signal_plans_for(const std::filesystem::path& file, const RoadGraph& graph) {
-  if (!is_sumo_net(file)) return default_signal_plans(graph);
+SignalMap signal_plans_for(const std::filesystem::path& file, const RoadGraph& graph) {
+  if (!is_sumo_net(file)) return signal_map_of(default_signal_plans(graph));
   const SumoNet net = read_sumo_net(file);
   const SumoGraph sumo = build_sumo_graph(net);
   if (sumo.graph.node_count() != graph.node_count() || sumo.graph.edge_count() != graph.edge_count()) {
     throw MapLoadError("'" + file.string() + "' changed since its graph was loaded");
   }
-  const auto plans = sumo_signal_plans(net);
-  return plans_by_node(sumo, net, plans);
+  return sumo_signal_map(sumo, net, sumo_signal_plans(net));
 }
 
 RoadGraph load_map(const std::filesystem::path& file, const MapLoadOptions& options, MapLoadInfo* info) {

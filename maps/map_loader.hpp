@@ -7,6 +7,7 @@
 
 #include "maps/osm_import.hpp"
 #include "maps/road_graph.hpp"
+#include "maps/signal_map.hpp"
 #include "maps/signal_plan.hpp"
 
 namespace corridor::maps {
@@ -31,9 +32,9 @@ RoadGraph load_map(const std::filesystem::path& file, const MapLoadOptions& opti
 
 bool is_sumo_net(const std::filesystem::path& file);
 
-// The signal plans for a map loaded by load_map: SUMO's traffic lights for a SUMO network, NEMA
-// plans at the OSM signals otherwise.
-std::unordered_map<NodeId, SignalPlan> signal_plans_for(const std::filesystem::path& file, const RoadGraph& graph);
+// The signals of a map loaded by load_map: SUMO's traffic lights for a SUMO network (one signal per
+// light over all its stop lines), NEMA plans at the OSM signals otherwise.
+SignalMap signal_plans_for(const std::filesystem::path& file, const RoadGraph& graph);
 
 // The cache file used for `source` inside `cache_dir`: one per absolute source path.
 std::filesystem::path cache_file_for(const std::filesystem::path& source, const std::filesystem::path& cache_dir);

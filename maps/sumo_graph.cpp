@@ -156,4 +156,25 @@ std::unordered_map<NodeId, SignalPlan> plans_by_node(const SumoGraph& graph, con
   return out;
 }
 
+SignalMap sumo_signal_map(const SumoGraph& graph, const SumoNet& net, const std::vector<SumoSignalPlan>& plans,
+                          std::unordered_map<NodeId, std::size_t>* tls_of_out) {
+  SignalMap m;
+  std::unordered_map<NodeId, std::size_t> tls_of;
+  m.plans = plans_by_node(graph, net, plans, &tls_of);
+  std::map<std::size_t, NodeId> key_of_tls;
+  for (const auto& [node, index] : tls_of) {
+    auto [it, fresh] = key_of_tls.emplace(index, node);
+    if (!fresh && node < it->second) it->second = node;
+  }
+  for (const auto& [node, index] : tls_of) m.signal_of[node] = key_of_tls.at(index);
+  for (const auto& [index, key] : key_of_tls) {
+    SignalPlan plan = m.plans.at(key);
+    plan.node = key;
+    m.signals.emplace(key, std::move(plan));
+    m.names.emplace(key, plans[index].tls_id);
+  }
+  if (tls_of_out != nullptr) *tls_of_out = std::move(tls_of);
+  return m;
+}
+
 }  // namespace corridor::maps

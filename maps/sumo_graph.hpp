@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "maps/road_graph.hpp"
+#include "maps/signal_map.hpp"
 #include "maps/sumo_net.hpp"
 
 namespace corridor::maps {
@@ -41,5 +42,10 @@ SumoGraph build_sumo_graph(const SumoNet& net, std::string_view vehicle_class = 
 std::unordered_map<NodeId, SignalPlan> plans_by_node(const SumoGraph& graph, const SumoNet& net,
                                                      const std::vector<SumoSignalPlan>& plans,
                                                      std::unordered_map<NodeId, std::size_t>* tls_of = nullptr);
+
+// The lights as signals: plans_by_node's plan at every stop line, and one signal per light keyed by
+// its lowest stop-line node and named by its tls id. `tls_of` receives each stop line's index into `plans`.
+SignalMap sumo_signal_map(const SumoGraph& graph, const SumoNet& net, const std::vector<SumoSignalPlan>& plans,
+                          std::unordered_map<NodeId, std::size_t>* tls_of = nullptr);
 
 }  // namespace corridor::maps

@@ -262,7 +262,7 @@ void DispatchService::tick(double now_s) {
     preemption_.tick(now_s);
     drain_preemption_events(staged);
     // Recovery ends inside the signals' own clock, without an engine event.
-    for (const auto& [node, plan] : plans_) announce_signal_state(node, now_s);
+    for (const auto& [node, plan] : signals_map_.signals) announce_signal_state(node, now_s);
   }
   submit(staged);
 }

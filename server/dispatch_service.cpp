@@ -68,15 +68,20 @@ DispatchService::DispatchService(const maps::RoadGraph& graph, DispatchConfig co
 
 DispatchService::DispatchService(const maps::RoadGraph& graph, std::unordered_map<NodeId, maps::SignalPlan> plans,
                                  DispatchConfig config, Store* store, double now_s)
+    : DispatchService(graph, maps::signal_map_of(std::move(plans)), config, store, now_s) {}
+
+DispatchService::DispatchService(const maps::RoadGraph& graph, maps::SignalMap signals, DispatchConfig config, Store* store,
+                                 double now_s)
     : graph_(graph),
       config_(config),
       store_(store),
       snapper_(graph),
       tracker_(graph, snapper_),
-      plans_(std::move(plans)),
+      signals_map_(std::move(signals)),
       overlay_(graph),
-      signals_(plans_, now_s),
-      preemption_(graph, plans_, signals_, config.preemption) {
+      signals_(signals_map_.signals, now_s),
+      preemption_(graph, signals_map_.signals, signals_, config.preemption) {
+  preemption_.set_signal_nodes(signals_map_.signal_of);
   if (config_.repair_threads < 1 || config_.repair_threads > 64) {
     throw std::invalid_argument("repair_threads must be 1 to 64, not " + std::to_string(config_.repair_threads));
   }
@@ -299,7 +304,8 @@ void DispatchService::persist_route(Mission& m, const std::string& reason, doubl
 }
 
 void DispatchService::retime_signals(Mission& m, double now_s, Staged& staged) {
-  const auto crossings = preemption::signalized_crossings(graph_, m.route, plans_, now_s);
+  auto crossings = preemption::signalized_crossings(graph_, m.route, plans_, now_s);
+  for (auto& c : crossings) c.node = signals_map_.key(c.node);
   std::lock_guard lock(preemption_mutex_);
   preemption_.update_route(m.row.id, m.row.priority, crossings, now_s);
   drain_preemption_events(staged);
@@ -592,7 +598,9 @@ PositionResult DispatchService::report_position(const PositionReport& p, double 
   if (pos_in_route != m.route.edges.end()) {
     const auto passed = static_cast<std::size_t>(pos_in_route - m.route.edges.begin());
     std::lock_guard signals(preemption_mutex_);
-    for (std::size_t i = 0; i < passed && i < m.route.nodes.size(); ++i) preemption_.vehicle_passed(m.row.id, m.route.nodes[i], now_s);
+    for (std::size_t i = 0; i < passed && i < m.route.nodes.size(); ++i) {
+      if (plans_.count(m.route.nodes[i]) != 0) preemption_.vehicle_passed(m.row.id, signals_map_.key(m.route.nodes[i]), now_s);
+    }
   }
 
   const std::vector<EdgeId> old_edges = m.route.edges;

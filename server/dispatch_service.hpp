@@ -16,12 +16,14 @@
 
 #include "maps/edge_snapper.hpp"
 #include "maps/road_graph.hpp"
+#include "maps/signal_map.hpp"
 #include "planner/dstar_lite.hpp"
 #include "preemption/engine.hpp"
 #include "preemption/simulated_signal_controller.hpp"
 #include "server/api_error.hpp"
 #include "server/commit_queue.hpp"
 #include "server/dispatch_types.hpp"
+#include "server/json_codec.hpp"
 #include "server/mission_planner.hpp"
 #include "server/shared_hierarchy.hpp"
 #include "server/store.hpp"
@@ -99,9 +101,11 @@ class DispatchService {
   // `store` may be null (nothing persisted). With a store, active missions and congestion in force
   // are restored. Throws StoreError when the database cannot be read.
   DispatchService(const maps::RoadGraph& graph, DispatchConfig config, Store* store, double now_s);
-  // With the map's own signal plans (for example a SUMO network's traffic lights).
+  // With the map's own signal plans, each node its own signal.
   DispatchService(const maps::RoadGraph& graph, std::unordered_map<NodeId, maps::SignalPlan> plans, DispatchConfig config,
                   Store* store, double now_s);
+  // With the map's own signals (a SUMO network's traffic lights, each over all its stop lines).
+  DispatchService(const maps::RoadGraph& graph, maps::SignalMap signals, DispatchConfig config, Store* store, double now_s);
   ~DispatchService();
 
   // Every method validates its input and throws ApiError with a status and a clear message. Every
@@ -113,7 +117,10 @@ class DispatchService {
   // Returns before its writes are durable: acknowledge only once `result.durable` says so.
   PositionResult report_position(const PositionReport& report, double now_s);
   CongestionResult report_congestion(const std::vector<CongestionUpdate>& updates, double now_s);
-  void report_counts(NodeId node, maps::Compass approach, double arrivals, double departures, double now_s);
+  // A signal's detector report for one approach (json_codec's CountsReport): counts for the queue
+  // estimate, occupancy or speed ratio for the congestion classifier, a standing queue for the
+  // vicinity rules. 400 for values out of range, 404 for a node without a signal.
+  void report_detectors(NodeId node, const CountsReport& report, double now_s);
   // Expires congestion and drives the signals; call about once a second.
   void tick(double now_s);
   // Waits until every write so far is durable.
@@ -124,7 +131,10 @@ class DispatchService {
   std::size_t subscribe(Listener listener);
   void unsubscribe(std::size_t id);
   [[nodiscard]] const maps::RoadGraph& graph() const { return graph_; }
-  [[nodiscard]] const std::unordered_map<NodeId, maps::SignalPlan>& signal_plans() const { return plans_; }
+  // The signals, one per controller, by key (maps::SignalMap); a signal id in the API is its key.
+  [[nodiscard]] const std::unordered_map<NodeId, maps::SignalPlan>& signal_plans() const { return signals_map_.signals; }
+  // The SUMO tls id of a signal, empty on an OSM map.
+  [[nodiscard]] std::string signal_name(NodeId signal) const;
   [[nodiscard]] std::vector<preemption::Light> signal_lights(NodeId node) const;
   // "held" (for an emergency vehicle), "clearing" (yellow and all-red on the way back) or
   // "program", and the program step; a simulator mirrors these onto its own lights.
@@ -213,7 +223,10 @@ class DispatchService {
   maps::EdgeSnapper snapper_;
   // Each vehicle's map matcher and last accepted fix; its locks are taken before, never under, ours.
   VehicleTracker tracker_;
-  const std::unordered_map<NodeId, maps::SignalPlan> plans_;
+  // The plan at every controlled node (routing costs, the route's crossings), and the signals the
+  // engine and the controller hold, one per controller.
+  const maps::SignalMap signals_map_;
+  const std::unordered_map<NodeId, maps::SignalPlan>& plans_ = signals_map_.plans;
   std::unordered_multimap<std::int64_t, EdgeId> edges_by_way_;
 
   // Read by every planner's repair (shared), written by congestion changes (exclusive); the

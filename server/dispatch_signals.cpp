@@ -4,6 +4,8 @@
 // announce_signal_state, drain_preemption_events).
 #include "server/dispatch_service.hpp"
 
+#include <cmath>
+
 #include "preemption/queue_estimator.hpp"
 
 namespace corridor::server {
@@ -20,14 +22,19 @@ std::string DispatchService::signal_state_locked(NodeId node) const {
   return "normal";
 }
 
+std::string DispatchService::signal_name(NodeId signal) const {
+  const auto it = signals_map_.names.find(signal);
+  return it == signals_map_.names.end() ? std::string{} : it->second;
+}
+
 std::string DispatchService::signal_state(NodeId node) const {
-  if (plans_.count(node) == 0) throw not_found("no signal at node " + std::to_string(node.v));
+  if (signals_map_.signals.count(node) == 0) throw not_found("no signal at node " + std::to_string(node.v));
   std::lock_guard lock(preemption_mutex_);
   return signal_state_locked(node);
 }
 
 void DispatchService::announce_signal_state(NodeId node, double now_s) {
-  if (plans_.count(node) == 0) return;
+  if (signals_map_.signals.count(node) == 0) return;
   std::string state = signal_state_locked(node);
   auto [it, fresh] = shown_signal_state_.try_emplace(node, "normal");
   if (it->second == state) return;
@@ -57,24 +64,40 @@ void DispatchService::drain_preemption_events(Staged& staged) {
   for (const auto& [node, time_s] : touched) announce_signal_state(node, time_s);
 }
 
-void DispatchService::report_counts(NodeId node, maps::Compass approach, double arrivals, double departures, double now_s) {
-  if (plans_.count(node) == 0) throw not_found("no signal at node " + std::to_string(node.v));
+void DispatchService::report_detectors(NodeId stop_line, const CountsReport& report, double now_s) {
+  // Any node the signal controls names it: a detector sits on one stop line's approach.
+  if (plans_.count(stop_line) == 0) throw not_found("no signal at node " + std::to_string(stop_line.v));
+  const NodeId node = signals_map_.key(stop_line);
   std::lock_guard lock(preemption_mutex_);
   try {
-    preemption_.record_counts(node, approach, now_s, arrivals, departures);
+    // Each part is checked before any is recorded, so that a report is taken whole or not at all.
+    if (report.occupancy && !(*report.occupancy >= 0.0 && *report.occupancy <= 1.0)) {
+      throw preemption::CountError("occupancy must be within [0, 1]");
+    }
+    if (report.speed_ratio && !(*report.speed_ratio >= 0.0 && std::isfinite(*report.speed_ratio))) {
+      throw preemption::CountError("speed_ratio must be a finite number >= 0");
+    }
+    if (report.queue_m && !(*report.queue_m >= 0.0 && *report.queue_m <= 100000.0)) {
+      throw preemption::CountError("queue_m must be a length in metres within [0, 100000]");
+    }
+    if (report.arrivals) preemption_.record_counts(node, report.approach, now_s, *report.arrivals, *report.departures);
+    if (report.occupancy || report.speed_ratio) {
+      preemption_.record_measurement(node, report.approach, report.occupancy, report.speed_ratio);
+    }
+    if (report.queue_m) preemption_.record_queue_length(node, report.approach, *report.queue_m);
   } catch (const preemption::CountError& e) {
     throw bad_request(e.what());
   }
 }
 
 std::vector<preemption::Light> DispatchService::signal_lights(NodeId node) const {
-  if (plans_.count(node) == 0) throw not_found("no signal at node " + std::to_string(node.v));
+  if (signals_map_.signals.count(node) == 0) throw not_found("no signal at node " + std::to_string(node.v));
   std::lock_guard lock(preemption_mutex_);
   return signals_.lights(node);
 }
 
 std::pair<std::string, std::size_t> DispatchService::signal_mode(NodeId node) const {
-  if (plans_.count(node) == 0) throw not_found("no signal at node " + std::to_string(node.v));
+  if (signals_map_.signals.count(node) == 0) throw not_found("no signal at node " + std::to_string(node.v));
   std::lock_guard lock(preemption_mutex_);
   const char* mode = signals_.mode(node) == preemption::SignalMode::held ? "held"
                      : signals_.running_program(node)                    ? "program"

@@ -137,8 +137,15 @@ std::vector<CongestionUpdate> congestion_from_json(const json& j) {
 CountsReport counts_from_json(const json& j) {
   CountsReport c;
   c.approach = compass(string_field(j, "approach"));
-  c.arrivals = number(require(j, "arrivals"), "arrivals");
-  c.departures = number(require(j, "departures"), "departures");
+  c.arrivals = optional_number(j, "arrivals");
+  c.departures = optional_number(j, "departures");
+  c.occupancy = optional_number(j, "occupancy");
+  c.speed_ratio = optional_number(j, "speed_ratio");
+  c.queue_m = optional_number(j, "queue_m");
+  if (c.arrivals.has_value() != c.departures.has_value()) throw bad_request("fields 'arrivals' and 'departures' go together");
+  if (!c.arrivals && !c.occupancy && !c.speed_ratio && !c.queue_m) {
+    throw bad_request("give arrivals and departures, occupancy, speed_ratio or queue_m");
+  }
   return c;
 }
 

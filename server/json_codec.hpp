@@ -17,10 +17,18 @@ MissionRequest mission_request_from_json(const nlohmann::json& j);
 PositionReport position_from_json(const nlohmann::json& j, const std::string& vehicle_id);
 std::vector<CongestionUpdate> congestion_from_json(const nlohmann::json& j);
 
+// What a signal's detectors measured on one approach over the last period: counts (loops at the
+// approach's entry and stop line), occupancy or a measured/free speed ratio (the congestion
+// classifier's input where no queue estimate exists), and the standing queue's length (a lane-area
+// detector's jam length, or a queue detector's): the vicinity rules' input. Each part is optional,
+// at least one is given, and counts come in pairs.
 struct CountsReport {
   maps::Compass approach;
-  double arrivals = 0;
-  double departures = 0;
+  std::optional<double> arrivals;
+  std::optional<double> departures;
+  std::optional<double> occupancy;
+  std::optional<double> speed_ratio;
+  std::optional<double> queue_m;
 };
 CountsReport counts_from_json(const nlohmann::json& j);
 

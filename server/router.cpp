@@ -243,12 +243,13 @@ Router::Router(DispatchService& service, TokenAuth auth, RouterConfig config, Cl
                                    {"slowest_replan_ms", res.slowest_replan_s * 1e3},
                                    {"customization_ms", res.customization_s * 1e3}});
       }, kBlocking);
-  add("POST", "/v1/signals/{id}/counts", kSensor, "Detector counts for a signal's approach",
+  add("POST", "/v1/signals/{id}/counts", kSensor,
+      "A signal's detector report for one approach: counts, occupancy or speed ratio, and the standing queue (DetectorReport)",
       [this](const Principal&, const Match& m, const HttpRequest& r) {
         const auto id = parse_id(m.params[0], "signal id");
         if (id >= service_.graph().node_count()) throw not_found("no signal " + m.params[0]);
         const CountsReport c = counts_from_json(parse_body(r.body));
-        service_.report_counts(NodeId{static_cast<std::uint32_t>(id)}, c.approach, c.arrivals, c.departures, clock_());
+        service_.report_detectors(NodeId{static_cast<std::uint32_t>(id)}, c, clock_());
         return json_response(200, {{"accepted", true}});
       });
   auto signal_json = [this](NodeId n, const maps::SignalPlan& plan) {
@@ -262,9 +263,11 @@ Router::Router(DispatchService& service, TokenAuth auth, RouterConfig config, Cl
     json phases = json::array();
     for (const auto& p : plan.phases) phases.push_back(p.label);
     const auto [mode, step] = service_.signal_mode(n);
-    return json{{"id", n.v}, {"osm_node", service_.graph().osm_node(n).v}, {"location", {{"lat", at.lat_deg}, {"lon", at.lon_deg}}},
-                {"phases", std::move(phases)}, {"lights", std::move(lights)},
-                {"mode", mode}, {"program_step", step}, {"state", service_.signal_state(n)}};
+    json out{{"id", n.v}, {"osm_node", service_.graph().osm_node(n).v}, {"location", {{"lat", at.lat_deg}, {"lon", at.lon_deg}}},
+             {"phases", std::move(phases)}, {"lights", std::move(lights)},
+             {"mode", mode}, {"program_step", step}, {"state", service_.signal_state(n)}};
+    if (const std::string name = service_.signal_name(n); !name.empty()) out["tls_id"] = name;
+    return out;
   };
   add("GET", "/v1/signals", kRead, "Every signalized intersection", [this, signal_json](const Principal&, const Match&, const HttpRequest&) {
     json list = json::array();

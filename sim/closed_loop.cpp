@@ -94,6 +94,12 @@ std::vector<Approach> approaches_of(const SumoScenario& scenario) {
         const bool covers = std::find(d.lanes.begin(), d.lanes.end(), lane.id) != d.lanes.end();
         if (covers && std::find(a.detectors.begin(), a.detectors.end(), d.id) == a.detectors.end()) a.detectors.push_back(d.id);
       }
+      for (const auto& loop : scenario.config->induction_loops) {
+        if (loop.lane != lane.id) continue;
+        // SUMO reads a negative position from the lane's end.
+        const double pos = loop.pos_m < 0.0 ? lane.length_m + loop.pos_m : loop.pos_m;
+        a.loops.push_back({loop.id, std::clamp(lane.length_m - pos, 0.0, lane.length_m), {}});
+      }
     }
     approaches.push_back(std::move(a));
   }
@@ -212,10 +218,88 @@ void count_lane_vehicles(const libsumo::SubscriptionResults& lanes, std::vector<
         }
       }
     }
-    for (const auto& v : now) a.arrivals += a.vehicles.contains(v) ? 0.0 : 1.0;
-    for (const auto& v : a.vehicles) a.departures += now.contains(v) ? 0.0 : 1.0;
+    // Where the user's loops count, they are the approach's counts (count_loop_vehicles).
+    if (!a.counts_arrivals_by_loop()) {
+      for (const auto& v : now) a.arrivals += a.vehicles.contains(v) ? 0.0 : 1.0;
+    }
+    if (!a.counts_departures_by_loop()) {
+      for (const auto& v : a.vehicles) a.departures += now.contains(v) ? 0.0 : 1.0;
+    }
     a.vehicles = std::move(now);
     a.halting = halting;
+  }
+}
+
+std::optional<LaneLink> link_of_lane(const SumoScenario& scenario, const std::string& lane, const std::string& next_edge) {
+  if (lane.empty()) return std::nullopt;
+  if (lane.front() == ':') {
+    // A junction's internal lane ":J_k_n", or one further along the same internal edge: the
+    // connection whose via lane is on that edge.
+    const std::string edge = lane.substr(0, lane.rfind('_'));
+    for (const maps::SumoConnection& c : scenario.net.connections) {
+      if (!c.tl.empty() && c.via.rfind(edge + "_", 0) == 0) return LaneLink{c.tl, c.link_index};
+    }
+    return std::nullopt;
+  }
+  // Before the junction: the connection from this lane towards the vehicle's next edge.
+  const auto underscore = lane.rfind('_');
+  if (underscore == std::string::npos) return std::nullopt;
+  const std::string from = lane.substr(0, underscore);
+  const int from_lane = std::atoi(lane.c_str() + underscore + 1);
+  for (const maps::SumoConnection& c : scenario.net.connections) {
+    if (!c.tl.empty() && c.from == from && c.from_lane == from_lane && (next_edge.empty() || c.to == next_edge)) {
+      return LaneLink{c.tl, c.link_index};
+    }
+  }
+  return std::nullopt;
+}
+
+// A loop this close to the stop line is a stop-bar detector: what it sees leave has crossed.
+constexpr double kStopBarLoopM = 15.0;
+
+bool Approach::counts_departures_by_loop() const {
+  return std::any_of(loops.begin(), loops.end(), [](const Loop& l) { return l.distance_m <= kStopBarLoopM; });
+}
+
+bool Approach::counts_arrivals_by_loop() const {
+  return std::any_of(loops.begin(), loops.end(), [](const Loop& l) { return l.distance_m > kStopBarLoopM; });
+}
+
+double reported_occupancy(const Approach& a) { return a.loops.empty() ? a.occupancy() : a.loop_occupancy; }
+
+void count_loop_vehicles(const libsumo::SubscriptionResults& loops, std::vector<Approach>& approaches) {
+  for (Approach& a : approaches) {
+    if (a.loops.empty()) continue;
+    a.loop_occupancy = 0.0;
+    a.loop_queue_m = 0.0;
+    for (Approach::Loop& loop : a.loops) {
+      const auto it = loops.find(loop.id);
+      if (it == loops.end()) continue;
+      std::set<std::string> now;
+      if (const auto ids = it->second.find(libsumo::LAST_STEP_VEHICLE_ID_LIST); ids != it->second.end()) {
+        if (const auto list = std::dynamic_pointer_cast<libsumo::TraCIStringList>(ids->second)) {
+          now.insert(list->value.begin(), list->value.end());
+        }
+      }
+      // A vehicle counts once, when it first reaches the loop.
+      double fresh = 0.0;
+      for (const auto& v : now) fresh += loop.vehicles.contains(v) ? 0.0 : 1.0;
+      if (loop.distance_m <= kStopBarLoopM) {
+        a.departures += fresh;
+      } else {
+        a.arrivals += fresh;
+      }
+      loop.vehicles = std::move(now);
+      const double occupancy = as_double(it->second, libsumo::LAST_STEP_OCCUPANCY);  // percent of the step
+      if (std::isfinite(occupancy)) a.loop_occupancy = std::max(a.loop_occupancy, std::clamp(occupancy / 100.0, 0.0, 1.0));
+      // A vehicle standing on the loop: the queue reaches back at least to it, and one car beyond.
+      const double speed = as_double(it->second, libsumo::LAST_STEP_MEAN_SPEED);
+      if (!loop.vehicles.empty() && std::isfinite(speed) && speed >= 0.0 && speed < 1.0) {
+        a.loop_queue_m = std::max(a.loop_queue_m, loop.distance_m + 7.5);
+      }
+    }
+    // Loops see the queue only where they are; lane-area detectors, where there are some, see all of it.
+    if (a.detectors.empty()) a.queue_m = a.loop_queue_m;
   }
 }
 

@@ -97,6 +97,23 @@ struct EvOutcome {
   std::size_t preempted_signals = 0;
 };
 
+// One collision SUMO reported, traced to the light it happened under: who hit whom, where, which
+// link each of them was taking and what it showed them, and whether Corridor held the light.
+struct CollisionRecord {
+  double time_s = 0.0;
+  std::string collider;
+  std::string victim;
+  std::string collider_type;  // vType ids ("ev_bluelight" for the EV with SUMO's device)
+  std::string victim_type;
+  std::string kind;  // SUMO's collision type: collision, frontal, junction, sharedLane, ...
+  std::string lane;
+  std::string tls;             // the light over the junction, if any
+  char collider_light = '-';   // the state of the collider's link ('G', 'g', 'y', 'r'), '-' off a light
+  char victim_light = '-';
+  bool held_by_corridor = false;  // the light was taken over by Corridor's controller then
+  bool ev_involved = false;
+};
+
 struct ClosedLoopResult {
   bool ev_arrived = false;
   double ev_travel_time_s = 0.0;
@@ -120,6 +137,8 @@ struct ClosedLoopResult {
   std::vector<EvOutcome> evs;  // every EV, the first one first (its figures are also the fields above)
   std::size_t deferrals = 0;   // over all EVs
   std::size_t approaches_with_detectors = 0;  // approaches whose queue comes from the user's e2 detectors
+  std::size_t approaches_with_loops = 0;      // approaches whose counts come from the user's induction loops
+  std::vector<CollisionRecord> collision_records;  // every collision, traced
 };
 
 // Throws SimError when SUMO fails or the EV's edges are unknown or unconnected.

@@ -12,6 +12,7 @@ struct LibsumoApi {
   using Edge = libsumo::Edge;
   using Lane = libsumo::Lane;
   using LaneArea = libsumo::LaneArea;
+  using InductionLoop = libsumo::InductionLoop;
   using Route = libsumo::Route;
   using Vehicle = libsumo::Vehicle;
   using TrafficLight = libsumo::TrafficLight;

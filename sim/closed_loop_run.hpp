@@ -70,6 +70,20 @@ struct Approach {
   double departures = 0.0;
   double queue_m = 0.0;                // the longest lane's standing queue, metres from the stop line
   std::vector<std::string> detectors;  // the user's e2 detectors on its lanes
+  // The user's induction loops (e1) on its lanes. Where there are some, they are the approach's
+  // detectors, as in the field: loops at the stop line count departures, loops upstream count
+  // arrivals, their occupancy is the approach's, and a loop with a vehicle stopped on it says the
+  // queue reaches back that far.
+  struct Loop {
+    std::string id;
+    double distance_m = 0.0;  // from the stop line
+    std::set<std::string> vehicles;  // on the loop at the last step
+  };
+  std::vector<Loop> loops;
+  double loop_occupancy = 0.0;  // the highest of its loops', 0..1, at the last step
+  double loop_queue_m = 0.0;    // the furthest loop with a stopped vehicle on it
+  [[nodiscard]] bool counts_departures_by_loop() const;
+  [[nodiscard]] bool counts_arrivals_by_loop() const;
   // 7.5 m of lane per halted vehicle.
   [[nodiscard]] double occupancy() const { return length_m > 0.0 ? std::clamp(halting * 7.5 / length_m, 0.0, 1.0) : 0.0; }
 };
@@ -83,12 +97,25 @@ void add_trip_results(const std::filesystem::path& tripinfo, const std::vector<s
 void count_lane_vehicles(const libsumo::SubscriptionResults& lanes, std::vector<Approach>& approaches);
 // The user's lane-area detectors' jam lengths, where an approach has them, replace its lanes' own.
 void add_detector_queues(const libsumo::SubscriptionResults& detectors, std::vector<Approach>& approaches);
+// The user's induction loops' vehicles, occupancy and speed (subscription results): their counts,
+// and at the report the occupancy and the queue they see, where an approach has them.
+void count_loop_vehicles(const libsumo::SubscriptionResults& loops, std::vector<Approach>& approaches);
+// The occupancy an approach reports: its loops' where it has any, else its halted vehicles'.
+[[nodiscard]] double reported_occupancy(const Approach& a);
 
 struct Incident {
   double time_s;
   std::string edge;
   bool applied = false;
 };
+
+// The light and link a vehicle on `lane` is taking: its connection's, where the lane is a junction's
+// internal lane or the approach lane of a controlled connection; nullopt off a light.
+struct LaneLink {
+  std::string tls;
+  int link_index = -1;
+};
+std::optional<LaneLink> link_of_lane(const SumoScenario& scenario, const std::string& lane, const std::string& next_edge);
 
 // The signal controller's TraCI calls, through either API.
 template <class Api>
@@ -212,7 +239,12 @@ ClosedLoopResult run_loop(const SumoScenario& scenario, const ClosedLoopConfig& 
       Api::Lane::subscribe(lane, {libsumo::LAST_STEP_VEHICLE_HALTING_NUMBER, libsumo::LAST_STEP_VEHICLE_ID_LIST});
     }
     for (const auto& detector : a.detectors) Api::LaneArea::subscribe(detector, {libsumo::JAM_LENGTH_METERS});
+    for (const auto& loop : a.loops) {
+      Api::InductionLoop::subscribe(loop.id, {libsumo::LAST_STEP_VEHICLE_ID_LIST, libsumo::LAST_STEP_OCCUPANCY,
+                                              libsumo::LAST_STEP_MEAN_SPEED});
+    }
     if (!a.detectors.empty()) ++result.approaches_with_detectors;
+    if (!a.loops.empty()) ++result.approaches_with_loops;
   }
 
   double last_congestion_s = -1e9;
@@ -240,9 +272,51 @@ ClosedLoopResult run_loop(const SumoScenario& scenario, const ClosedLoopConfig& 
     t = bridge.step();
     lights_api.now_s = t;
     const auto sim = Api::Simulation::getSubscriptionResults();
-    result.collisions += static_cast<int>(as_double(sim, libsumo::VAR_COLLIDING_VEHICLES_NUMBER));
+    const int colliding = static_cast<int>(as_double(sim, libsumo::VAR_COLLIDING_VEHICLES_NUMBER));
+    result.collisions += colliding;
+    if (colliding > 0) {
+      // Each collision traced to its light: what each vehicle's link showed and whether Corridor held it.
+      for (const libsumo::TraCICollision& c : Api::Simulation::getCollisions()) {
+        CollisionRecord r;
+        r.time_s = t;
+        r.collider = c.collider;
+        r.victim = c.victim;
+        r.collider_type = c.colliderType;
+        r.victim_type = c.victimType;
+        r.kind = c.type;
+        r.lane = c.lane;
+        r.ev_involved = c.collider.rfind(kEv, 0) == 0 || c.victim.rfind(kEv, 0) == 0;
+        const auto light_of = [&](const std::string& vehicle, char& light) {
+          try {
+            const std::string lane = Api::Vehicle::getLaneID(vehicle);
+            const std::vector<std::string> route = Api::Vehicle::getRoute(vehicle);
+            const auto index = static_cast<std::size_t>(std::max(0, Api::Vehicle::getRouteIndex(vehicle)));
+            const auto link = link_of_lane(scenario, lane, index + 1 < route.size() ? route[index + 1] : std::string{});
+            if (!link) return;
+            r.tls = link->tls;
+            const std::string state = Api::TrafficLight::getRedYellowGreenState(link->tls);
+            if (link->link_index >= 0 && static_cast<std::size_t>(link->link_index) < state.size()) light = state[static_cast<std::size_t>(link->link_index)];
+          } catch (const libsumo::TraCIException&) {
+            // The vehicle is gone (teleported or removed): its light is not known.
+          }
+        };
+        light_of(c.collider, r.collider_light);
+        light_of(c.victim, r.victim_light);
+        if (!r.tls.empty()) {
+          for (const auto& [node, plan] : scenario.signal_plans) {
+            if (scenario.sumo_plan_of.at(node)->tls_id == r.tls) r.held_by_corridor = controller.mode(node) == preemption::SignalMode::held;
+          }
+        }
+        spdlog::info("event=collision t={:.0f} collider={} ({}) victim={} ({}) kind={} lane={} tls={} collider_light={} "
+                     "victim_light={} held_by_corridor={}",
+                     t, r.collider, r.collider_type, r.victim, r.victim_type, r.kind, r.lane, r.tls.empty() ? "-" : r.tls,
+                     r.collider_light, r.victim_light, r.held_by_corridor);
+        result.collision_records.push_back(std::move(r));
+      }
+    }
     result.teleports += static_cast<int>(as_double(sim, libsumo::VAR_TELEPORT_STARTING_VEHICLES_NUMBER));
     count_lane_vehicles(Api::Lane::getAllSubscriptionResults(), approaches);
+    count_loop_vehicles(Api::InductionLoop::getAllSubscriptionResults(), approaches);
 
     // Measured travel times become congestion updates every period (the detection system).
     std::vector<EdgeId> changed;
@@ -277,7 +351,7 @@ ClosedLoopResult run_loop(const SumoScenario& scenario, const ClosedLoopConfig& 
         Measured& m = measured[{signal_of(scenario, a.node), a.side}];
         m.arrivals += a.arrivals;
         m.departures += a.departures;
-        m.occupancy = std::max(m.occupancy, a.occupancy());
+        m.occupancy = std::max(m.occupancy, reported_occupancy(a));
         m.queue_m = std::max(m.queue_m, a.queue_m);
         a.arrivals = a.departures = 0.0;
       }

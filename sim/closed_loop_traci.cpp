@@ -11,6 +11,7 @@ struct TraciApi {
   using Edge = libtraci::Edge;
   using Lane = libtraci::Lane;
   using LaneArea = libtraci::LaneArea;
+  using InductionLoop = libtraci::InductionLoop;
   using Route = libtraci::Route;
   using Vehicle = libtraci::Vehicle;
   using TrafficLight = libtraci::TrafficLight;

@@ -156,7 +156,7 @@ ExperimentTables write_experiment_tables(std::vector<PlannedRecord> runs, const 
       "routing,signals,volume,seed,ev_travel_time_s,ev_stops,ev_wait_s,preempted_signals,others_delay_rel,collisions,"
       "teleports,ev_arrived,ev_time_loss_s,route_changes,replans,lights_taken_over,lights_back_on_program,"
       "safety_violations,others,others_mean_time_loss_s,baseline_time_loss_s,demand_scale,scenario,ev_from,ev_to,"
-      "vicinity,evs,evs_arrived,evs_travel_time_mean_s,deferrals,status,failure\n";
+      "vicinity,evs,evs_arrived,evs_travel_time_mean_s,deferrals,status,failure,collisions_at_held_lights\n";
   for (const ExperimentRow& row : rows) {
     const RunRecord& r = row.run;
     const std::string identity_head = fmt::format("{},{},{:g},{}", to_string(r.routing), to_string(r.signals), r.volume, r.seed);
@@ -165,7 +165,7 @@ ExperimentTables write_experiment_tables(std::vector<PlannedRecord> runs, const 
     if (!row.ok()) {
       // A run that did not complete has no figures: empty fields, not zeros that read as results.
       csv += identity_head + std::string(17, ',') + number_or_empty(row.baseline_time_loss_s.value_or(std::nan("")), "{:.3f}") + "," +
-             identity_tail + ",,,,failed," + csv_field(r.failure) + "\n";
+             identity_tail + ",,,,failed," + csv_field(r.failure) + ",\n";
       continue;
     }
     std::size_t evs_arrived = 0;
@@ -174,14 +174,16 @@ ExperimentTables write_experiment_tables(std::vector<PlannedRecord> runs, const 
       evs_arrived += e.arrived ? 1 : 0;
       evs_time += e.arrived ? e.travel_time_s : 0.0;
     }
-    csv += fmt::format("{},{:.1f},{},{:.1f},{},{},{},{},{},{:.1f},{},{},{},{},{},{},{:.3f},{},{},{},{:.1f},{},ok,\n",
+    const auto at_held = std::count_if(r.result.collision_records.begin(), r.result.collision_records.end(),
+                                       [](const CollisionRecord& c) { return c.held_by_corridor; });
+    csv += fmt::format("{},{:.1f},{},{:.1f},{},{},{},{},{},{:.1f},{},{},{},{},{},{},{:.3f},{},{},{},{:.1f},{},ok,,{}\n",
                        identity_head, r.result.ev_travel_time_s, r.result.ev_stops, r.result.ev_wait_s, r.result.preempted_signals,
                        number_or_empty(row.others_delay_rel(), "{:.4f}"), r.result.collisions, r.result.teleports,
                        r.result.ev_arrived ? 1 : 0, r.result.ev_time_loss_s, r.result.route_changes, r.result.replans,
                        r.result.lights_taken_over, r.result.lights_back_on_program, r.result.safety_violations.size(),
                        r.result.others, r.result.others_mean_time_loss_s,
                        number_or_empty(row.baseline_time_loss_s.value_or(std::nan("")), "{:.3f}"), identity_tail, evs_arrived,
-                       evs_arrived > 0 ? evs_time / static_cast<double>(evs_arrived) : 0.0, r.result.deferrals);
+                       evs_arrived > 0 ? evs_time / static_cast<double>(evs_arrived) : 0.0, r.result.deferrals, at_held);
   }
   std::filesystem::create_directories(out_dir);
   write_text(out_dir / "sumo_runs.csv", csv);
@@ -337,6 +339,17 @@ ExperimentTables write_experiment_tables(std::vector<PlannedRecord> runs, const 
                       out.failures.size());
     for (const auto& f : out.failures) md += "- " + f + "\n";
   }
+  // Every collision traced to its light, so that one can be told apart from Corridor's doing.
+  std::string collisions;
+  for (const ExperimentRow& row : rows) {
+    for (const CollisionRecord& c : row.run.result.collision_records) {
+      collisions += fmt::format("- {}, t={:.0f} s: {} ({}) into {} ({}), {} on {}{}; lights: {} {}, {} {}{}\n", run_name(row.run),
+                                c.time_s, c.collider, c.collider_type, c.victim, c.victim_type, c.kind, c.lane,
+                                c.tls.empty() ? "" : " under light " + c.tls, c.collider, c.collider_light, c.victim,
+                                c.victim_light, c.held_by_corridor ? "; the light was held by Corridor" : "");
+    }
+  }
+  if (!collisions.empty()) md += "\nCollisions, each traced to the light over it:\n\n" + collisions;
   write_text(out_dir / "sumo_summary.csv", summary);
   write_text(out_dir / "sumo_summary.md", md);
   const bool injected = std::any_of(rows.begin(), rows.end(), [](const ExperimentRow& r) { return r.run.inject_on_route; });

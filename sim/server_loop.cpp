@@ -69,13 +69,20 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
   for (const auto& [id, arcs] : sg.arcs_onto) libtraci::Edge::subscribe(id, {libsumo::VAR_CURRENT_TRAVELTIME});
   std::vector<double> factor(g.edge_count(), 1.0);
   std::vector<Approach> approaches = approaches_of(scenario);
+  ClosedLoopResult result;
   for (const Approach& a : approaches) {
     for (const auto& lane : a.lanes) {
       libtraci::Lane::subscribe(lane, {libsumo::LAST_STEP_VEHICLE_HALTING_NUMBER, libsumo::LAST_STEP_VEHICLE_ID_LIST});
     }
+    for (const auto& detector : a.detectors) libtraci::LaneArea::subscribe(detector, {libsumo::JAM_LENGTH_METERS});
+    for (const auto& loop : a.loops) {
+      libtraci::InductionLoop::subscribe(loop.id, {libsumo::LAST_STEP_VEHICLE_ID_LIST, libsumo::LAST_STEP_OCCUPANCY,
+                                                   libsumo::LAST_STEP_MEAN_SPEED});
+    }
+    if (!a.detectors.empty()) ++result.approaches_with_detectors;
+    if (!a.loops.empty()) ++result.approaches_with_loops;
   }
 
-  ClosedLoopResult result;
   const std::string vehicle = "ev-" + config.run_name;
   // The EV's receiver and onboard localizer (only with gps_noise_m > 0).
   const maps::EdgeSnapper snapper(g);
@@ -108,6 +115,7 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
     result.collisions += static_cast<int>(as_double(sim, libsumo::VAR_COLLIDING_VEHICLES_NUMBER));
     result.teleports += static_cast<int>(as_double(sim, libsumo::VAR_TELEPORT_STARTING_VEHICLES_NUMBER));
     count_lane_vehicles(libtraci::Lane::getAllSubscriptionResults(), approaches);
+    count_loop_vehicles(libtraci::InductionLoop::getAllSubscriptionResults(), approaches);
 
     if (t - last_congestion_s >= config.congestion_period_s) {
       last_congestion_s = t;
@@ -124,12 +132,14 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
           updates.push_back({{"edge", arc.v}, {"factor", f}});
         }
       }
-      // The approaches' detector counts, as the sensor role would send them.
+      // The approaches' detector reports, as a detector feed with the sensor role sends them:
+      // counts, occupancy and the standing queue (the user's e2 jam lengths where they have them),
+      // so that the server's engine runs vicinity-aware preemption as the in-process loop does.
+      add_detector_queues(libtraci::LaneArea::getAllSubscriptionResults(), approaches);
       for (Approach& a : approaches) {
-        if (a.arrivals > 0.0 || a.departures > 0.0) {
-          server.post("/v1/signals/" + std::to_string(a.node.v) + "/counts",
-                      {{"approach", std::string(1, maps::compass_letter(a.side))}, {"arrivals", a.arrivals}, {"departures", a.departures}});
-        }
+        server.post("/v1/signals/" + std::to_string(a.node.v) + "/counts",
+                    {{"approach", std::string(1, maps::compass_letter(a.side))}, {"arrivals", a.arrivals}, {"departures", a.departures},
+                     {"occupancy", reported_occupancy(a)}, {"queue_m", a.queue_m}});
         a.arrivals = a.departures = 0.0;
       }
       if (!updates.empty()) {

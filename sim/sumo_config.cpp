@@ -84,9 +84,21 @@ std::optional<std::string> parse_xml(const std::string& text, void* user, XML_St
 
 struct DetectorParse {
   std::vector<LaneAreaDetector> detectors;
+  std::vector<InductionLoop> loops;
 };
 
 void on_detector(void* user, const char* name, const char** attrs) {
+  auto& st = *static_cast<DetectorParse*>(user);
+  if (std::strcmp(name, "inductionLoop") == 0 || std::strcmp(name, "e1Detector") == 0) {
+    InductionLoop loop;
+    for (const char** a = attrs; *a != nullptr; a += 2) {
+      if (std::strcmp(a[0], "id") == 0) loop.id = a[1];
+      if (std::strcmp(a[0], "lane") == 0) loop.lane = a[1];
+      if (std::strcmp(a[0], "pos") == 0) loop.pos_m = std::strtod(a[1], nullptr);
+    }
+    if (!loop.id.empty() && !loop.lane.empty() && std::isfinite(loop.pos_m)) st.loops.push_back(std::move(loop));
+    return;
+  }
   if (std::strcmp(name, "laneAreaDetector") != 0 && std::strcmp(name, "e2Detector") != 0) return;
   LaneAreaDetector d;
   for (const char** a = attrs; *a != nullptr; a += 2) {
@@ -98,18 +110,19 @@ void on_detector(void* user, const char* name, const char** attrs) {
       for (std::string lane; in >> lane;) d.lanes.push_back(lane);
     }
   }
-  if (!d.id.empty() && !d.lanes.empty()) static_cast<DetectorParse*>(user)->detectors.push_back(std::move(d));
+  if (!d.id.empty() && !d.lanes.empty()) st.detectors.push_back(std::move(d));
 }
 
-// The e2 detectors of one additional file; SUMO itself reports a malformed file when it loads it.
-std::vector<LaneAreaDetector> read_lane_area_detectors(const std::filesystem::path& file) {
+// The e2 and e1 detectors of one additional file; SUMO itself reports a malformed file when it
+// loads it.
+DetectorParse read_detectors(const std::filesystem::path& file) {
   std::ifstream in(file, std::ios::binary);
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   DetectorParse st;
   if (const auto error = parse_xml(text, &st, on_detector, nullptr)) {
     throw SimError("additional file '" + file.string() + "' is not valid XML: " + *error);
   }
-  return std::move(st.detectors);
+  return st;
 }
 
 }  // namespace
@@ -194,7 +207,9 @@ SumoConfig read_sumo_config(const std::filesystem::path& file) {
   }
   if (c.net_file.empty()) throw SimError("'" + file.string() + "' names no net-file: a scenario needs its network");
   for (const auto& additional : c.additional_files) {
-    for (auto& d : read_lane_area_detectors(additional)) c.lane_area_detectors.push_back(std::move(d));
+    DetectorParse found = read_detectors(additional);
+    for (auto& d : found.detectors) c.lane_area_detectors.push_back(std::move(d));
+    for (auto& l : found.loops) c.induction_loops.push_back(std::move(l));
   }
   if (c.end_s && *c.end_s <= c.begin_s) {
     throw SimError("'" + file.string() + "': end must come after begin");

@@ -21,6 +21,14 @@ struct LaneAreaDetector {
   std::vector<std::string> lanes;  // `lane`, or the chain of `lanes`
 };
 
+// An induction loop (e1) of the user's additional files: where it sits on its lane. SUMO reads a
+// negative position from the lane's end.
+struct InductionLoop {
+  std::string id;
+  std::string lane;
+  double pos_m = 0.0;
+};
+
 struct SumoConfig {
   std::filesystem::path file;  // absolute
   // Every option the file sets, as it sets it (a synonym stays a synonym), in file order: a run's
@@ -37,6 +45,9 @@ struct SumoConfig {
   // The e2 detectors the additional files declare (laneAreaDetector or e2Detector): where present,
   // their jam lengths are the queue estimate of the approaches they cover.
   std::vector<LaneAreaDetector> lane_area_detectors;
+  // The induction loops (inductionLoop or e1Detector): where present on an approach, their counts,
+  // occupancy and stopped vehicles are what the approach's detectors report.
+  std::vector<InductionLoop> induction_loops;
 };
 
 // Throws SimError, naming the file and the option, for a configuration that is missing, not XML,

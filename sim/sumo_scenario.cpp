@@ -1,6 +1,5 @@
 #include "sim/sumo_scenario.hpp"
 
-#include <map>
 #include <memory>
 
 namespace corridor::sim {
@@ -21,24 +20,17 @@ std::unique_ptr<SumoScenario> load_sumo_scenario(const ScenarioNet& scenario_net
                                                           scenario_net.config,
                                                           SumoOptionCatalog::from_sumo("sumo", scenario_net.dir)});
   s->sumo_plans = maps::sumo_signal_plans(s->net);
+  // The same signals the server keys a SUMO net's lights by.
   std::unordered_map<NodeId, std::size_t> tls_of;
-  s->plans = maps::plans_by_node(s->graph, s->net, s->sumo_plans, &tls_of);
+  maps::SignalMap signals = maps::sumo_signal_map(s->graph, s->net, s->sumo_plans, &tls_of);
   for (const auto& [node, index] : tls_of) s->sumo_plan_of[node] = &s->sumo_plans[index];
   for (const auto& logic : s->net.tl_logics) {
     s->tls_phases[logic.id] = logic.phases;
     if (logic.type == "actuated" || logic.type == "delay_based") s->actuated_tls.insert(logic.id);
   }
-  std::map<std::size_t, NodeId> key_of_tls;
-  for (const auto& [node, index] : tls_of) {
-    auto [it, fresh] = key_of_tls.emplace(index, node);
-    if (!fresh && node < it->second) it->second = node;
-  }
-  for (const auto& [node, index] : tls_of) s->signal_node[node] = key_of_tls.at(index);
-  for (const auto& [index, key] : key_of_tls) {
-    maps::SignalPlan plan = s->plans.at(key);
-    plan.node = key;
-    s->signal_plans.emplace(key, std::move(plan));
-  }
+  s->plans = std::move(signals.plans);
+  s->signal_plans = std::move(signals.signals);
+  s->signal_node = std::move(signals.signal_of);
   return s;
 }
 

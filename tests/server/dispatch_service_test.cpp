@@ -176,6 +176,48 @@ TEST(DispatchService, PositionsAlongTheRouteCompleteTheMission) {
   for (const auto& e : finished) EXPECT_NE(e.state, preemption::EntryState::active);
 }
 
+// A detector's standing queue on an approach the route takes (POST .../counts with queue_m) starts
+// that light's hold earlier, early enough to clear the queue: vicinity-aware preemption in the
+// server. A report out of range is refused whole.
+TEST(DispatchService, ADetectorsQueueOnTheApproachStartsItsHoldEarlier) {
+  DispatchConfig config;
+  config.preemption.vicinity.enabled = true;
+  DispatchService service(grid(), config, nullptr, 0.0);
+  const MissionView m = service.create_mission(request("amb-q"), 0.0);
+  // The last crossing: far enough ahead for an earlier start to show.
+  ASSERT_FALSE(m.schedule.empty());
+  const auto target = std::max_element(m.schedule.begin(), m.schedule.end(),
+                                       [](const auto& a, const auto& b) { return a.arrival_s < b.arrival_s; });
+  ASSERT_GT(target->arrival_s, 60.0);
+  const NodeId node = target->node;
+  const double before = target->start_s;
+  CountsReport queue;
+  const char side = target->movement_label.front();  // "N->S"
+  queue.approach = side == 'N' ? maps::Compass::north : side == 'E' ? maps::Compass::east : side == 'S' ? maps::Compass::south
+                                                                                                  : maps::Compass::west;
+  queue.queue_m = 60.0;
+  service.report_detectors(node, queue, 1.0);
+  CountsReport bad = queue;
+  bad.occupancy = 1.5;
+  EXPECT_EQ(code_of([&] { service.report_detectors(node, bad, 1.0); }), 400);
+  bad = queue;
+  bad.queue_m = -3.0;
+  EXPECT_EQ(code_of([&] { service.report_detectors(node, bad, 1.0); }), 400);
+  EXPECT_EQ(code_of([&] { service.report_detectors(NodeId{static_cast<std::uint32_t>(grid().node_count() + 5)}, queue, 1.0); }), 404);
+  // The next position report re-times the mission's signals with the queue.
+  PositionReport p;
+  p.vehicle_id = "amb-q";
+  p.position = corner(false);
+  p.timestamp_s = 2.0;
+  service.report_position(p, 2.0);
+  const auto after = service.mission(m.id).schedule;
+  const auto it = std::find_if(after.begin(), after.end(), [&](const auto& e) { return e.node == node; });
+  ASSERT_NE(it, after.end());
+  EXPECT_EQ(it->vicinity, "approach_queue");
+  // The queue's 8 vehicles take l1 + h·8 = 18 s to discharge, and the vehicle meets its tail first.
+  EXPECT_LT(it->start_s, before - 15.0) << "before " << before << " s, after " << it->start_s << " s";
+}
+
 TEST(DispatchService, CongestionOnTheRouteChangesIt) {
   DispatchService service(grid(), {}, nullptr, 0.0);
   std::vector<DispatchEvent> events;

@@ -176,10 +176,16 @@ TEST(Router, SignalsMapHealthAndMetrics) {
   ASSERT_FALSE(signals["signals"].empty());
   const auto first = signals["signals"][0]["id"].get<std::uint32_t>();
   EXPECT_EQ(rig.call("GET", "/v1/signals/" + std::to_string(first), kViewer).status, 200);
-  EXPECT_EQ(rig.call("POST", "/v1/signals/" + std::to_string(first) + "/counts", kSensor,
-                     R"({"approach":"N","arrivals":4,"departures":1})")
-                .status,
-            200);
+  const std::string counts = "/v1/signals/" + std::to_string(first) + "/counts";
+  EXPECT_EQ(rig.call("POST", counts, kSensor, R"({"approach":"N","arrivals":4,"departures":1})").status, 200);
+  // A detector report may carry occupancy, a speed ratio and the standing queue instead.
+  EXPECT_EQ(rig.call("POST", counts, kSensor, R"({"approach":"N","queue_m":42.5,"occupancy":0.4})").status, 200);
+  EXPECT_EQ(rig.call("POST", counts, kSensor, R"({"approach":"E","speed_ratio":0.3})").status, 200);
+  for (const char* bad : {R"({"approach":"N"})", R"({"approach":"N","arrivals":4})", R"({"approach":"N","queue_m":-1})",
+                          R"({"approach":"N","occupancy":1.2})", R"({"approach":"N","queue_m":"far"})",
+                          R"({"approach":"N","queue_m":1e300})"}) {
+    EXPECT_EQ(rig.call("POST", counts, kSensor, bad).status, 400) << bad;
+  }
   const json map = body(rig.call("GET", "/v1/map", kViewer));
   EXPECT_EQ(map["type"], "FeatureCollection");
   EXPECT_GT(map["features"].size(), grid().edge_count() / 3);

@@ -125,7 +125,7 @@ TEST_F(SumoCollectTest, EveryPlannedRunIsARowAndTheHeadlineIsPaired) {
   EXPECT_EQ(failed, 2u);
   EXPECT_EQ(tables.failures.size(), 2u);
   const std::string runs = read("sumo_runs.csv");
-  EXPECT_NE(runs.find(",failed,\"Vehicle 'ev' has no valid route, \"\"am90\"\" to am91\"\n"), std::string::npos) << runs;
+  EXPECT_NE(runs.find(",failed,\"Vehicle 'ev' has no valid route, \"\"am90\"\" to am91\",\n"), std::string::npos) << runs;
   EXPECT_NE(runs.find("c3.run.json: no result"), std::string::npos) << runs;
   EXPECT_EQ(std::count(runs.begin(), runs.end(), '\n'), 10);
   const std::string md = read("sumo_summary.md");

@@ -85,9 +85,9 @@ TEST_F(SumoConfigTest, EachBadCaseNamesTheFileAndTheOption) {
   EXPECT_NE(error_of(dir_ / "broken.sumocfg").find("XML error"), std::string::npos);
 }
 
-// The user's lane-area detectors, in both of SUMO's spellings and with a lane chain; other
-// detectors are not lane-area ones. A broken additional file is a clear error.
-TEST_F(SumoConfigTest, ReadsTheLaneAreaDetectorsOfTheAdditionalFiles) {
+// The user's lane-area detectors, in both of SUMO's spellings and with a lane chain, and their
+// induction loops. A broken additional file is a clear error.
+TEST_F(SumoConfigTest, ReadsTheLaneAreaDetectorsAndInductionLoopsOfTheAdditionalFiles) {
   write("det.add.xml",
         "<additional><laneAreaDetector id=\"q1\" lane=\"e1_0\" pos=\"0\" length=\"50\" file=\"o.xml\"/>"
         "<e2Detector id=\"q2\" lanes=\"e2_0 e3_0\" pos=\"0\" endPos=\"10\" file=\"o.xml\"/>"
@@ -98,6 +98,10 @@ TEST_F(SumoConfigTest, ReadsTheLaneAreaDetectorsOfTheAdditionalFiles) {
   EXPECT_EQ(c.lane_area_detectors[0].lanes, std::vector<std::string>{"e1_0"});
   EXPECT_EQ(c.lane_area_detectors[1].id, "q2");
   EXPECT_EQ(c.lane_area_detectors[1].lanes, (std::vector<std::string>{"e2_0", "e3_0"}));
+  ASSERT_EQ(c.induction_loops.size(), 1u);
+  EXPECT_EQ(c.induction_loops[0].id, "loop");
+  EXPECT_EQ(c.induction_loops[0].lane, "e4_0");
+  EXPECT_DOUBLE_EQ(c.induction_loops[0].pos_m, 1.0);
   write("det.add.xml", "<additional><laneAreaDetector");
   EXPECT_NE(error_of(cfg("<net-file value=\"sub/city.net.xml\"/><additional-files value=\"det.add.xml\"/>")).find("det.add.xml"),
             std::string::npos);
