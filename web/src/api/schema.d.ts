@@ -4,6 +4,148 @@
  */
 
 export interface paths {
+    "/metrics": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** Prometheus metrics */
+        get: {
+            parameters: {
+                query?: never;
+                header?: never;
+                path?: never;
+                cookie?: never;
+            };
+            requestBody?: never;
+            responses: {
+                /** @description OK */
+                200: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Malformed request */
+                400: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content: {
+                        "application/json": components["schemas"]["Error"];
+                    };
+                };
+                /** @description Missing or invalid token */
+                401: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Token lacks the role */
+                403: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Unknown id */
+                404: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Valid JSON that cannot be applied (off the map, unreachable) */
+                422: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+            };
+        };
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/v1/congestion": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** Report congestion on edges or OSM ways */
+        post: {
+            parameters: {
+                query?: never;
+                header?: never;
+                path?: never;
+                cookie?: never;
+            };
+            requestBody?: never;
+            responses: {
+                /** @description OK */
+                200: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Malformed request */
+                400: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content: {
+                        "application/json": components["schemas"]["Error"];
+                    };
+                };
+                /** @description Missing or invalid token */
+                401: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Token lacks the role */
+                403: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Unknown id */
+                404: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Valid JSON that cannot be applied (off the map, unreachable) */
+                422: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+            };
+        };
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/v1/health": {
         parameters: {
             query?: never;
@@ -26,45 +168,7 @@ export interface paths {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Health"];
-                    };
-                };
-            };
-        };
-        put?: never;
-        post?: never;
-        delete?: never;
-        options?: never;
-        head?: never;
-        patch?: never;
-        trace?: never;
-    };
-    "/v1/me": {
-        parameters: {
-            query?: never;
-            header?: never;
-            path?: never;
-            cookie?: never;
-        };
-        /** The caller: name, roles and vehicle */
-        get: {
-            parameters: {
-                query?: never;
-                header?: never;
-                path?: never;
-                cookie?: never;
-            };
-            requestBody?: never;
-            responses: {
-                /** @description OK */
-                200: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Me"];
-                    };
+                    content?: never;
                 };
                 /** @description Malformed request */
                 400: {
@@ -77,238 +181,31 @@ export interface paths {
                 };
                 /** @description Missing or invalid token */
                 401: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Token lacks the role */
-                403: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Unknown id */
-                404: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description State conflict */
-                409: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Body too large */
-                413: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Valid JSON that cannot be applied */
-                422: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Rate limited */
-                429: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Storage unavailable */
-                503: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-            };
-        };
-        put?: never;
-        post?: never;
-        delete?: never;
-        options?: never;
-        head?: never;
-        patch?: never;
-        trace?: never;
-    };
-    "/v1/stream/ticket": {
-        parameters: {
-            query?: never;
-            header?: never;
-            path?: never;
-            cookie?: never;
-        };
-        get?: never;
-        put?: never;
-        /** A single-use ticket for the event stream */
-        post: {
-            parameters: {
-                query?: never;
-                header?: never;
-                path?: never;
-                cookie?: never;
-            };
-            requestBody?: never;
-            responses: {
-                /** @description OK */
-                200: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Ticket"];
-                    };
-                };
-                /** @description Malformed request */
-                400: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Missing or invalid token */
-                401: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Token lacks the role */
-                403: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Unknown id */
-                404: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description State conflict */
-                409: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Body too large */
-                413: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Valid JSON that cannot be applied */
-                422: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Rate limited */
-                429: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Storage unavailable */
-                503: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-            };
-        };
-        delete?: never;
-        options?: never;
-        head?: never;
-        patch?: never;
-        trace?: never;
-    };
-    "/v1/stream": {
-        parameters: {
-            query?: never;
-            header?: never;
-            path?: never;
-            cookie?: never;
-        };
-        /** WebSocket stream of events (upgrade); ?ticket=T, optional ?mission=ID. Each message is one Event. */
-        get: {
-            parameters: {
-                query: {
-                    ticket: string;
-                    mission?: number;
-                };
-                header?: never;
-                path?: never;
-                cookie?: never;
-            };
-            requestBody?: never;
-            responses: {
-                /** @description Switching protocols */
-                101: {
                     headers: {
                         [name: string]: unknown;
                     };
                     content?: never;
                 };
-                /** @description Bad or expired ticket */
-                401: {
+                /** @description Token lacks the role */
+                403: {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
+                    content?: never;
+                };
+                /** @description Unknown id */
+                404: {
+                    headers: {
+                        [name: string]: unknown;
                     };
+                    content?: never;
+                };
+                /** @description Valid JSON that cannot be applied (off the map, unreachable) */
+                422: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
                 };
             };
         };
@@ -342,9 +239,7 @@ export interface paths {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["MapFeatureCollection"];
-                    };
+                    content?: never;
                 };
                 /** @description Malformed request */
                 400: {
@@ -360,57 +255,65 @@ export interface paths {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
                 /** @description Token lacks the role */
                 403: {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
                 /** @description Unknown id */
                 404: {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
-                /** @description State conflict */
-                409: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Body too large */
-                413: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Valid JSON that cannot be applied */
+                /** @description Valid JSON that cannot be applied (off the map, unreachable) */
                 422: {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
-                /** @description Rate limited */
-                429: {
+            };
+        };
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/v1/me": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** The calling token's name and roles */
+        get: {
+            parameters: {
+                query?: never;
+                header?: never;
+                path?: never;
+                cookie?: never;
+            };
+            requestBody?: never;
+            responses: {
+                /** @description OK */
+                200: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Malformed request */
+                400: {
                     headers: {
                         [name: string]: unknown;
                     };
@@ -418,14 +321,33 @@ export interface paths {
                         "application/json": components["schemas"]["Error"];
                     };
                 };
-                /** @description Storage unavailable */
-                503: {
+                /** @description Missing or invalid token */
+                401: {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
+                    content?: never;
+                };
+                /** @description Token lacks the role */
+                403: {
+                    headers: {
+                        [name: string]: unknown;
                     };
+                    content?: never;
+                };
+                /** @description Unknown id */
+                404: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Valid JSON that cannot be applied (off the map, unreachable) */
+                422: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
                 };
             };
         };
@@ -444,12 +366,10 @@ export interface paths {
             path?: never;
             cookie?: never;
         };
-        /** List missions */
+        /** List missions (?state=active|completed|cancelled) */
         get: {
             parameters: {
-                query?: {
-                    state?: "active" | "completed" | "cancelled";
-                };
+                query?: never;
                 header?: never;
                 path?: never;
                 cookie?: never;
@@ -461,11 +381,7 @@ export interface paths {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": {
-                            missions: components["schemas"]["Mission"][];
-                        };
-                    };
+                    content?: never;
                 };
                 /** @description Malformed request */
                 400: {
@@ -481,72 +397,28 @@ export interface paths {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
                 /** @description Token lacks the role */
                 403: {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
                 /** @description Unknown id */
                 404: {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
-                /** @description State conflict */
-                409: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Body too large */
-                413: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Valid JSON that cannot be applied */
+                /** @description Valid JSON that cannot be applied (off the map, unreachable) */
                 422: {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Rate limited */
-                429: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Storage unavailable */
-                503: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
             };
         };
@@ -559,20 +431,21 @@ export interface paths {
                 path?: never;
                 cookie?: never;
             };
-            requestBody: {
-                content: {
-                    "application/json": components["schemas"]["MissionRequest"];
-                };
-            };
+            requestBody?: never;
             responses: {
+                /** @description OK */
+                200: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
                 /** @description Created */
                 201: {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Mission"];
-                    };
+                    content?: never;
                 };
                 /** @description Malformed request */
                 400: {
@@ -588,72 +461,28 @@ export interface paths {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
                 /** @description Token lacks the role */
                 403: {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
                 /** @description Unknown id */
                 404: {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
-                /** @description State conflict */
-                409: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Body too large */
-                413: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Valid JSON that cannot be applied */
+                /** @description Valid JSON that cannot be applied (off the map, unreachable) */
                 422: {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Rate limited */
-                429: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Storage unavailable */
-                503: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
             };
         };
@@ -687,9 +516,7 @@ export interface paths {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Mission"];
-                    };
+                    content?: never;
                 };
                 /** @description Malformed request */
                 400: {
@@ -705,72 +532,28 @@ export interface paths {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
                 /** @description Token lacks the role */
                 403: {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
                 /** @description Unknown id */
                 404: {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
-                /** @description State conflict */
-                409: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Body too large */
-                413: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Valid JSON that cannot be applied */
+                /** @description Valid JSON that cannot be applied (off the map, unreachable) */
                 422: {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Rate limited */
-                429: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Storage unavailable */
-                503: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
             };
         };
@@ -808,9 +591,7 @@ export interface paths {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Mission"];
-                    };
+                    content?: never;
                 };
                 /** @description Malformed request */
                 400: {
@@ -826,72 +607,28 @@ export interface paths {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
                 /** @description Token lacks the role */
                 403: {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
                 /** @description Unknown id */
                 404: {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
-                /** @description State conflict */
-                409: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Body too large */
-                413: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Valid JSON that cannot be applied */
+                /** @description Valid JSON that cannot be applied (off the map, unreachable) */
                 422: {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Rate limited */
-                429: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Storage unavailable */
-                503: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
             };
         };
@@ -908,7 +645,7 @@ export interface paths {
             path?: never;
             cookie?: never;
         };
-        /** Route history, oldest first */
+        /** A mission's route revisions with their reasons, oldest first */
         get: {
             parameters: {
                 query?: never;
@@ -925,11 +662,7 @@ export interface paths {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": {
-                            revisions: components["schemas"]["RouteRevision"][];
-                        };
-                    };
+                    content?: never;
                 };
                 /** @description Malformed request */
                 400: {
@@ -945,72 +678,28 @@ export interface paths {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
                 /** @description Token lacks the role */
                 403: {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
                 /** @description Unknown id */
                 404: {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
-                /** @description State conflict */
-                409: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Body too large */
-                413: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Valid JSON that cannot be applied */
+                /** @description Valid JSON that cannot be applied (off the map, unreachable) */
                 422: {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Rate limited */
-                429: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Storage unavailable */
-                503: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
             };
         };
@@ -1022,14 +711,14 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
-    "/v1/vehicles": {
+    "/v1/openapi.json": {
         parameters: {
             query?: never;
             header?: never;
             path?: never;
             cookie?: never;
         };
-        /** Every vehicle with its last position */
+        /** This API description */
         get: {
             parameters: {
                 query?: never;
@@ -1044,11 +733,7 @@ export interface paths {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": {
-                            vehicles: components["schemas"]["Vehicle"][];
-                        };
-                    };
+                    content?: never;
                 };
                 /** @description Malformed request */
                 400: {
@@ -1064,321 +749,33 @@ export interface paths {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
                 /** @description Token lacks the role */
                 403: {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
                 /** @description Unknown id */
                 404: {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
-                /** @description State conflict */
-                409: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Body too large */
-                413: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Valid JSON that cannot be applied */
+                /** @description Valid JSON that cannot be applied (off the map, unreachable) */
                 422: {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Rate limited */
-                429: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Storage unavailable */
-                503: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
             };
         };
         put?: never;
         post?: never;
-        delete?: never;
-        options?: never;
-        head?: never;
-        patch?: never;
-        trace?: never;
-    };
-    "/v1/vehicles/{id}/position": {
-        parameters: {
-            query?: never;
-            header?: never;
-            path?: never;
-            cookie?: never;
-        };
-        get?: never;
-        put?: never;
-        /** Report a vehicle position */
-        post: {
-            parameters: {
-                query?: never;
-                header?: never;
-                path: {
-                    id: string;
-                };
-                cookie?: never;
-            };
-            requestBody: {
-                content: {
-                    "application/json": components["schemas"]["PositionReport"];
-                };
-            };
-            responses: {
-                /** @description OK */
-                200: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["PositionResult"];
-                    };
-                };
-                /** @description Malformed request */
-                400: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Missing or invalid token */
-                401: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Token lacks the role */
-                403: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Unknown id */
-                404: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description State conflict */
-                409: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Body too large */
-                413: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Valid JSON that cannot be applied */
-                422: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Rate limited */
-                429: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Storage unavailable */
-                503: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-            };
-        };
-        delete?: never;
-        options?: never;
-        head?: never;
-        patch?: never;
-        trace?: never;
-    };
-    "/v1/congestion": {
-        parameters: {
-            query?: never;
-            header?: never;
-            path?: never;
-            cookie?: never;
-        };
-        get?: never;
-        put?: never;
-        /** Report congestion on edges or OSM ways */
-        post: {
-            parameters: {
-                query?: never;
-                header?: never;
-                path?: never;
-                cookie?: never;
-            };
-            requestBody: {
-                content: {
-                    "application/json": components["schemas"]["CongestionRequest"];
-                };
-            };
-            responses: {
-                /** @description OK */
-                200: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["CongestionResult"];
-                    };
-                };
-                /** @description Malformed request */
-                400: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Missing or invalid token */
-                401: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Token lacks the role */
-                403: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Unknown id */
-                404: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description State conflict */
-                409: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Body too large */
-                413: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Valid JSON that cannot be applied */
-                422: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Rate limited */
-                429: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Storage unavailable */
-                503: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-            };
-        };
         delete?: never;
         options?: never;
         head?: never;
@@ -1407,11 +804,7 @@ export interface paths {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": {
-                            signals: components["schemas"]["Signal"][];
-                        };
-                    };
+                    content?: never;
                 };
                 /** @description Malformed request */
                 400: {
@@ -1427,72 +820,28 @@ export interface paths {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
                 /** @description Token lacks the role */
                 403: {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
                 /** @description Unknown id */
                 404: {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
-                /** @description State conflict */
-                409: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Body too large */
-                413: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Valid JSON that cannot be applied */
+                /** @description Valid JSON that cannot be applied (off the map, unreachable) */
                 422: {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Rate limited */
-                429: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Storage unavailable */
-                503: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
             };
         };
@@ -1528,9 +877,7 @@ export interface paths {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Signal"];
-                    };
+                    content?: never;
                 };
                 /** @description Malformed request */
                 400: {
@@ -1546,72 +893,28 @@ export interface paths {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
                 /** @description Token lacks the role */
                 403: {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
                 /** @description Unknown id */
                 404: {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
-                /** @description State conflict */
-                409: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Body too large */
-                413: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Valid JSON that cannot be applied */
+                /** @description Valid JSON that cannot be applied (off the map, unreachable) */
                 422: {
                     headers: {
                         [name: string]: unknown;
                     };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Rate limited */
-                429: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
-                };
-                /** @description Storage unavailable */
-                503: {
-                    headers: {
-                        [name: string]: unknown;
-                    };
-                    content: {
-                        "application/json": components["schemas"]["Error"];
-                    };
+                    content?: never;
                 };
             };
         };
@@ -1623,195 +926,341 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/v1/signals/{id}/counts": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** A signal's detector report for one approach: counts, occupancy or speed ratio, and the standing queue (DetectorReport) */
+        post: {
+            parameters: {
+                query?: never;
+                header?: never;
+                path: {
+                    id: string;
+                };
+                cookie?: never;
+            };
+            requestBody?: never;
+            responses: {
+                /** @description OK */
+                200: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Malformed request */
+                400: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content: {
+                        "application/json": components["schemas"]["Error"];
+                    };
+                };
+                /** @description Missing or invalid token */
+                401: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Token lacks the role */
+                403: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Unknown id */
+                404: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Valid JSON that cannot be applied (off the map, unreachable) */
+                422: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+            };
+        };
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/v1/stream": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** WebSocket stream of events (upgrade); ?mission=ID to follow one mission */
+        get: {
+            parameters: {
+                query?: never;
+                header?: never;
+                path?: never;
+                cookie?: never;
+            };
+            requestBody?: never;
+            responses: {
+                /** @description Switching protocols */
+                101: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+            };
+        };
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/v1/stream/ticket": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** A single-use ticket to open the WebSocket stream (?ticket=) within 30 s */
+        post: {
+            parameters: {
+                query?: never;
+                header?: never;
+                path?: never;
+                cookie?: never;
+            };
+            requestBody?: never;
+            responses: {
+                /** @description OK */
+                200: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Malformed request */
+                400: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content: {
+                        "application/json": components["schemas"]["Error"];
+                    };
+                };
+                /** @description Missing or invalid token */
+                401: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Token lacks the role */
+                403: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Unknown id */
+                404: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Valid JSON that cannot be applied (off the map, unreachable) */
+                422: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+            };
+        };
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/v1/vehicles": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** Every vehicle's latest accepted position */
+        get: {
+            parameters: {
+                query?: never;
+                header?: never;
+                path?: never;
+                cookie?: never;
+            };
+            requestBody?: never;
+            responses: {
+                /** @description OK */
+                200: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Malformed request */
+                400: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content: {
+                        "application/json": components["schemas"]["Error"];
+                    };
+                };
+                /** @description Missing or invalid token */
+                401: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Token lacks the role */
+                403: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Unknown id */
+                404: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Valid JSON that cannot be applied (off the map, unreachable) */
+                422: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+            };
+        };
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/v1/vehicles/{id}/position": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        get?: never;
+        put?: never;
+        /** Report a vehicle position */
+        post: {
+            parameters: {
+                query?: never;
+                header?: never;
+                path: {
+                    id: string;
+                };
+                cookie?: never;
+            };
+            requestBody?: never;
+            responses: {
+                /** @description OK */
+                200: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Malformed request */
+                400: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content: {
+                        "application/json": components["schemas"]["Error"];
+                    };
+                };
+                /** @description Missing or invalid token */
+                401: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Token lacks the role */
+                403: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Unknown id */
+                404: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Valid JSON that cannot be applied (off the map, unreachable) */
+                422: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+            };
+        };
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
 }
 export type webhooks = Record<string, never>;
 export interface components {
     schemas: {
-        /** @description Every error answer: 400, 401, 403, 404, 409, 413, 422, 429, 503. */
-        Error: {
-            error: {
-                /** @description Machine-readable, e.g. bad_request, unauthorized, not_found */
-                code: string;
-                /** @description What went wrong, in words a user can act on */
-                message: string;
-            };
-        };
-        LatLon: {
-            lat: number;
-            lon: number;
-        };
-        LineString: {
-            /** @enum {string} */
-            type: "LineString";
-            /** @description [lon, lat] pairs */
-            coordinates: number[][];
-        };
-        Me: {
-            name: string;
-            roles: ("dispatcher" | "vehicle" | "sensor" | "viewer")[];
-            /** @description The vehicle a vehicle-role token may report for */
-            vehicle_id: string | null;
-        };
-        /** @description Single-use ticket for opening /v1/stream?ticket=...; the WebSocket never carries the long-lived token. */
-        Ticket: {
-            ticket: string;
-            expires_in_s: number;
-        };
-        Health: {
-            status: string;
-            active_missions: number;
-            map: {
-                nodes: number;
-                edges: number;
-            };
-        };
-        /** @description One turn-by-turn instruction, OSRM style. */
-        Step: {
-            /** @description Street name, empty when none */
-            name: string;
-            /** @description Road reference, empty when none */
-            ref: string;
-            distance_m: number;
-            duration_s: number;
-            /**
-             * @description ferry while the step rides a ferry or shuttle train (route=ferry|shuttle_train)
-             * @enum {string}
-             */
-            mode: "driving" | "ferry";
-            maneuver: {
-                /** @enum {string} */
-                type: "depart" | "turn" | "new name" | "continue" | "roundabout" | "arrive";
-                /** @enum {string|null} */
-                modifier: "left" | "right" | "straight" | "slight left" | "slight right" | "sharp left" | "sharp right" | "uturn" | null;
-                /** @description Roundabout exit number */
-                exit?: number;
-                /** @description [lon, lat] */
-                location: number[];
-            };
-        };
-        /** @description A planned route as one GeoJSON Feature. */
-        RouteFeature: {
-            /** @enum {string} */
-            type: "Feature";
-            geometry: components["schemas"]["LineString"];
-            properties: {
-                travel_time_s: number;
-                length_m: number;
-                algorithm: string;
-                /** @description Graph node ids along the route */
-                nodes: number[];
-                /** @description Graph edge ids along the route */
-                edges: number[];
-                osm_nodes: number[];
-                /** @description Per node: seconds from the route's start */
-                arrival_s: number[];
-                /** @description Signalized node ids on the route */
-                signals: number[];
-                /** @description Per edge: index into geometry.coordinates where that edge's piece starts */
-                edge_coordinate_index?: number[];
-                /** @description Per edge: 1 is free flow; very large or null is closed */
-                congestion_factors?: (number | null)[];
-                steps?: components["schemas"]["Step"][];
-                /** @description Per edge: the street name (or ref), empty when none */
-                names?: string[];
-            };
-        };
-        /** @description One signal's preemption for a mission. */
-        ScheduleEntry: {
-            /** @description Graph node id of the signalized intersection */
-            signal: number;
-            /** Format: int64 */
-            osm_node: number;
-            location: components["schemas"]["LatLon"];
-            movement: string;
-            phase: string;
-            /** @enum {string} */
-            congestion: "low" | "high";
-            /** @description Unix seconds: preemption starts */
-            start_s: number;
-            /** @description Unix seconds: predicted arrival of the vehicle */
-            arrival_s: number;
-            /** @description Unix seconds: the signal returns to its program */
-            release_s: number;
-            /** @description planned, active, released, cancelled, expired, or another state the server adds later */
-            state: string;
-            deferred: boolean;
-        };
-        Mission: {
-            id: number;
-            vehicle_id: string;
-            /** @enum {string} */
-            state: "active" | "completed" | "cancelled";
-            priority: number;
-            vmax_kmh: number;
-            /**
-             * @description The vehicle profile the route is planned with: turn rules, turn costs, dimensions
-             * @enum {string}
-             */
-            profile: "ambulance" | "fire_engine";
-            destination: components["schemas"]["LatLon"];
-            route_revision: number;
-            created_s: number;
-            updated_s: number;
-            last_position: components["schemas"]["LatLon"] | null;
-            /** @description Seconds remaining at updated_s */
-            eta_s: number | null;
-            /** @description Unix seconds of the predicted arrival */
-            eta_at_s: number | null;
-            preemption: components["schemas"]["ScheduleEntry"][];
-            route: components["schemas"]["RouteFeature"] | null;
-        };
-        MissionRequest: {
-            vehicle_id: string;
-            destination: components["schemas"]["LatLon"];
-            origin?: components["schemas"]["LatLon"];
-            priority?: number;
-            /** @description Default: the profile's top speed (ambulance 120, fire_engine 90) */
-            vmax_kmh?: number;
-            /**
-             * @description The vehicle profile to plan with; ambulance when absent
-             * @enum {string}
-             */
-            profile?: "ambulance" | "fire_engine";
-        };
-        RouteRevision: {
-            revision: number;
-            /** @description Why the route changed: dispatch (the first route), congestion, deviation, position, restored, ... */
-            reason: string;
-            time_s: number;
-            eta_s: number | null;
-            length_m: number;
-            geometry: components["schemas"]["LineString"];
-        };
-        Vehicle: {
-            vehicle_id: string;
-            lat: number;
-            lon: number;
-            heading_deg: number | null;
-            speed_mps: number | null;
-            timestamp: number;
-            source: string;
-            mission: number | null;
-        };
-        PositionReport: {
-            lat: number;
-            lon: number;
-            timestamp: number;
-            heading_deg?: number;
-            speed_mps?: number;
-            hdop?: number;
-            /** @enum {string} */
-            source?: "gps" | "vo";
-        };
         CongestionRequest: {
             updates: {
                 edge?: number;
+                expires_in_s?: number;
+                factor?: number;
                 /** Format: int64 */
                 osm_way_id?: number;
-                factor?: number;
                 speed_kmh?: number;
                 travel_time_s?: number;
-                expires_in_s?: number;
             }[];
         };
         CongestionResult: {
@@ -1825,103 +1274,295 @@ export interface components {
             routes_changed: number;
             slowest_replan_ms: number;
         };
-        Signal: {
-            id: number;
-            /** Format: int64 */
-            osm_node: number;
-            location: components["schemas"]["LatLon"];
-            phases: string[];
-            lights: {
-                movement: string;
-                /** @enum {string} */
-                light: "green" | "yellow" | "red";
-            }[];
+        /** @description What a signal's detectors measured on one approach over the last period; at least one of the counts (both), occupancy, speed_ratio or queue_m */
+        DetectorReport: {
             /** @enum {string} */
-            mode: "program" | "held" | "clearing";
-            program_step: number;
-            /** @enum {string} */
-            state: "normal" | "scheduled" | "held" | "recovering";
+            approach: "N" | "E" | "S" | "W";
+            /** @description vehicles that entered the approach since the last report */
+            arrivals?: number;
+            /** @description vehicles that crossed the stop line since the last report */
+            departures?: number;
+            occupancy?: number;
+            /** @description the standing queue, metres back from the stop line (the longest lane's) */
+            queue_m?: number;
+            /** @description measured over free-flow speed */
+            speed_ratio?: number;
+        };
+        /** @description Every error answer: 400, 401, 403, 404, 409, 413, 422, 429, 503. */
+        Error: {
+            error: {
+                /** @description Machine-readable, e.g. bad_request, unauthorized, not_found */
+                code: string;
+                /** @description What went wrong, in words a user can act on */
+                message: string;
+            };
         };
         /** @description One WebSocket message. Clients must ignore types and fields they do not know. */
         Event: {
-            /** @description Increases by event within one server process */
-            seq: number;
-            /** @description mission_created, mission_completed, mission_cancelled, route_changed, position, preemption_scheduled, preemption_started, preemption_released, preemption_deferred, signal_state, congestion_applied, ... */
-            type: string;
-            mission: number | null;
-            reason: string;
-            time_s: number;
-            vehicle_id?: string;
-            revision?: number;
+            edges_changed?: number;
             eta_s?: number | null;
+            heading_deg?: number | null;
             lat?: number;
             lon?: number;
-            heading_deg?: number | null;
-            speed_mps?: number | null;
-            source?: string;
+            mission: number | null;
+            reason: string;
+            revision?: number;
+            /** @description Increases by event within one server process */
+            seq: number;
             signal?: number;
+            source?: string;
+            speed_mps?: number | null;
             state?: string;
-            edges_changed?: number;
+            time_s: number;
+            /** @description mission_created, mission_completed, mission_cancelled, route_changed, position, preemption_scheduled, preemption_started, preemption_released, preemption_deferred, signal_state, congestion_applied, ... */
+            type: string;
+            vehicle_id?: string;
+        };
+        Health: {
+            active_missions: number;
+            map: {
+                edges: number;
+                nodes: number;
+            };
+            status: string;
+        };
+        LatLon: {
+            lat: number;
+            lon: number;
+        };
+        LineString: {
+            /** @description [lon, lat] pairs */
+            coordinates: number[][];
+            /** @enum {string} */
+            type: "LineString";
         };
         MapFeature: {
-            /** @enum {string} */
-            type: "Feature";
             geometry: components["schemas"]["LineString"];
             properties: {
-                edge: number;
-                /** @description The opposite direction's edge, if any */
-                twin: number | null;
-                /** Format: int64 */
-                osm_way_id: number;
                 /** @description OSM highway class: motorway, primary, residential, ... */
                 class: string;
-                speed_kmh: number;
+                edge: number;
                 length_m: number;
                 name: string;
+                /** Format: int64 */
+                osm_way_id: number;
                 ref: string;
+                speed_kmh: number;
+                /** @description The opposite direction's edge, if any */
+                twin: number | null;
             };
+            /** @enum {string} */
+            type: "Feature";
         };
         MapFeatureCollection: {
-            /** @enum {string} */
-            type: "FeatureCollection";
             attribution: string;
             /** @description [[minLon, minLat], [maxLon, maxLat]] */
             bounds: number[][];
             features: components["schemas"]["MapFeature"][];
+            /** @enum {string} */
+            type: "FeatureCollection";
+        };
+        Me: {
+            name: string;
+            roles: ("dispatcher" | "vehicle" | "sensor" | "viewer")[];
+            /** @description The vehicle a vehicle-role token may report for */
+            vehicle_id: string | null;
+        };
+        Mission: {
+            created_s: number;
+            destination: components["schemas"]["LatLon"];
+            /** @description Unix seconds of the predicted arrival */
+            eta_at_s: number | null;
+            /** @description Seconds remaining at updated_s */
+            eta_s: number | null;
+            id: number;
+            last_position: components["schemas"]["LatLon"] | null;
+            preemption: components["schemas"]["ScheduleEntry"][];
+            priority: number;
+            /**
+             * @description The vehicle profile the route is planned with: turn rules, turn costs, dimensions
+             * @enum {string}
+             */
+            profile: "ambulance" | "fire_engine";
+            route: components["schemas"]["RouteFeature"] | null;
+            route_revision: number;
+            /** @enum {string} */
+            state: "active" | "completed" | "cancelled";
+            updated_s: number;
+            vehicle_id: string;
+            vmax_kmh: number;
+        };
+        MissionRequest: {
+            destination: components["schemas"]["LatLon"];
+            origin?: components["schemas"]["LatLon"];
+            priority?: number;
+            /**
+             * @description The vehicle profile to plan with; ambulance when absent
+             * @enum {string}
+             */
+            profile?: "ambulance" | "fire_engine";
+            vehicle_id: string;
+            /** @description Default: the profile's top speed (ambulance 120, fire_engine 90) */
+            vmax_kmh?: number;
+        };
+        PositionReport: {
+            hdop?: number;
+            heading_deg?: number;
+            lat: number;
+            lon: number;
+            /** @enum {string} */
+            source?: "gps" | "vo";
+            speed_mps?: number;
+            timestamp: number;
         };
         /** @description The answer to a position report */
         PositionResult: {
             accepted: boolean;
             /** @description The report completed the vehicle's mission */
             completed: boolean;
-            eta_s: number | null;
-            mission: number | null;
-            route_changed: boolean;
-            /** @description Distance from the report to the road it was snapped to */
-            snap_distance_m: number | null;
-            /** @description The report moved the vehicle (false: stored only) */
-            followed: boolean;
             /**
              * @description What the vehicle tracker made of the report: followed, or stored only as older than the last accepted one, the same again, a jump faster than a vehicle drives, or GPS with HDOP over 10
              * @enum {string}
              */
             disposition: "followed" | "stale" | "duplicate" | "outlier" | "low_accuracy";
-            /** @description The fix as received */
-            raw: {
-                lat: number;
-                lon: number;
-                timestamp: number;
-                source: string;
-            };
             /** @description The edge the vehicle's map matcher put it on */
             edge: number | null;
-            osm_way_id?: number;
+            eta_s: number | null;
+            /** @description The report moved the vehicle (false: stored only) */
+            followed: boolean;
+            /** @description The matcher's probability share for the chosen road point, 0..1 */
+            match_confidence: number | null;
+            mission: number | null;
             /** @description The street's name */
             name?: string;
             /** @description Along the matched edge */
             offset_m?: number;
-            /** @description The matcher's probability share for the chosen road point, 0..1 */
-            match_confidence: number | null;
+            osm_way_id?: number;
+            /** @description The fix as received */
+            raw: {
+                lat: number;
+                lon: number;
+                source: string;
+                timestamp: number;
+            };
+            route_changed: boolean;
+            /** @description Distance from the report to the road it was snapped to */
+            snap_distance_m: number | null;
+        };
+        /** @description A planned route as one GeoJSON Feature. */
+        RouteFeature: {
+            geometry: components["schemas"]["LineString"];
+            properties: {
+                algorithm: string;
+                /** @description Per node: seconds from the route's start */
+                arrival_s: number[];
+                /** @description Per edge: 1 is free flow; very large or null is closed */
+                congestion_factors?: (number | null)[];
+                /** @description Per edge: index into geometry.coordinates where that edge's piece starts */
+                edge_coordinate_index?: number[];
+                /** @description Graph edge ids along the route */
+                edges: number[];
+                length_m: number;
+                /** @description Per edge: the street name (or ref), empty when none */
+                names?: string[];
+                /** @description Graph node ids along the route */
+                nodes: number[];
+                osm_nodes: number[];
+                /** @description Signalized node ids on the route */
+                signals: number[];
+                steps?: components["schemas"]["Step"][];
+                travel_time_s: number;
+            };
+            /** @enum {string} */
+            type: "Feature";
+        };
+        RouteRevision: {
+            eta_s: number | null;
+            geometry: components["schemas"]["LineString"];
+            length_m: number;
+            /** @description Why the route changed: dispatch (the first route), congestion, deviation, position, restored, ... */
+            reason: string;
+            revision: number;
+            time_s: number;
+        };
+        /** @description One signal's preemption for a mission. */
+        ScheduleEntry: {
+            /** @description Unix seconds: predicted arrival of the vehicle */
+            arrival_s: number;
+            /** @enum {string} */
+            congestion: "low" | "high";
+            deferred: boolean;
+            location: components["schemas"]["LatLon"];
+            movement: string;
+            /** Format: int64 */
+            osm_node: number;
+            phase: string;
+            /** @description Unix seconds: the signal returns to its program */
+            release_s: number;
+            /** @description Graph node id of the signalized intersection */
+            signal: number;
+            /** @description Unix seconds: preemption starts */
+            start_s: number;
+            /** @description planned, active, released, cancelled, expired, or another state the server adds later */
+            state: string;
+        };
+        Signal: {
+            id: number;
+            lights: {
+                /** @enum {string} */
+                light: "green" | "yellow" | "red";
+                movement: string;
+            }[];
+            location: components["schemas"]["LatLon"];
+            /** @enum {string} */
+            mode: "program" | "held" | "clearing";
+            /** Format: int64 */
+            osm_node: number;
+            phases: string[];
+            program_step: number;
+            /** @enum {string} */
+            state: "normal" | "scheduled" | "held" | "recovering";
+            /** @description On a SUMO network: the traffic light's id (one signal over all its stop lines) */
+            tls_id?: string;
+        };
+        /** @description One turn-by-turn instruction, OSRM style. */
+        Step: {
+            distance_m: number;
+            duration_s: number;
+            maneuver: {
+                /** @description Roundabout exit number */
+                exit?: number;
+                /** @description [lon, lat] */
+                location: number[];
+                /** @enum {string|null} */
+                modifier: "left" | "right" | "straight" | "slight left" | "slight right" | "sharp left" | "sharp right" | "uturn" | null;
+                /** @enum {string} */
+                type: "depart" | "turn" | "new name" | "continue" | "roundabout" | "arrive";
+            };
+            /**
+             * @description ferry while the step rides a ferry or shuttle train (route=ferry|shuttle_train)
+             * @enum {string}
+             */
+            mode: "driving" | "ferry";
+            /** @description Street name, empty when none */
+            name: string;
+            /** @description Road reference, empty when none */
+            ref: string;
+        };
+        /** @description Single-use ticket for opening /v1/stream?ticket=...; the WebSocket never carries the long-lived token. */
+        Ticket: {
+            expires_in_s: number;
+            ticket: string;
+        };
+        Vehicle: {
+            heading_deg: number | null;
+            lat: number;
+            lon: number;
+            mission: number | null;
+            source: string;
+            speed_mps: number | null;
+            timestamp: number;
+            vehicle_id: string;
         };
     };
     responses: never;
