@@ -14,6 +14,7 @@
 #include "app/preemption_command.hpp"
 #include "app/route_command.hpp"
 #include "app/serve_command.hpp"
+#include "app/signal_agent_command.hpp"
 #include "app/sim_command.hpp"
 #include "app/vo_command.hpp"
 #include "maps/errors.hpp"
@@ -36,6 +37,7 @@ int main(int argc, char** argv) {
   corridor::app::register_serve_command(app);
   corridor::app::register_experiment_command(app);
   corridor::app::register_sim_command(app);
+  corridor::app::register_signal_agent_command(app);
   corridor::app::register_vo_command(app);
   corridor::app::register_match_command(app);
   corridor::app::register_localize_command(app);

@@ -9,11 +9,13 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <random>
 #include <thread>
 
 #include "app/cli_error.hpp"
 #include "app/map_options.hpp"
+#include "ntcip/controllers_file.hpp"
 #include "server/demo_driver.hpp"
 #include "server/dispatch_service.hpp"
 #include "server/http_server.hpp"
@@ -35,6 +37,7 @@ struct ServeOptions {
   int background_nice = 10;
   bool demo = false;
   bool route_only = false;
+  std::string controllers;
   server::PlannerGraph planner_graph = server::PlannerGraph::automatic;
 };
 
@@ -133,7 +136,23 @@ void run_serve(const ServeOptions& o) {
   // Vicinity-aware preemption: the detectors' queues (POST /v1/signals/{id}/counts with queue_m)
   // start holds early enough to clear them; without detector reports it is route-only.
   dispatch.preemption.vicinity.enabled = !o.route_only;
-  server::DispatchService service(graph, maps::signal_plans_for(map_file, graph), dispatch, &store, now());
+  if (!o.controllers.empty()) {
+    try {
+      dispatch.field_controllers = ntcip::read_controllers_file(o.controllers);
+    } catch (const ntcip::ControllersFileError& e) {
+      throw UsageError(std::string("--controllers: ") + e.what());
+    }
+  }
+  std::optional<server::DispatchService> service_slot;
+  try {
+    service_slot.emplace(graph, maps::signal_plans_for(map_file, graph), dispatch, &store, now());
+  } catch (const ntcip::ControllersFileError& e) {
+    throw UsageError(std::string("--controllers: ") + e.what());
+  }
+  server::DispatchService& service = *service_slot;
+  if (!dispatch.field_controllers.empty()) {
+    std::cout << dispatch.field_controllers.size() << " signal controllers driven over NTCIP 1202 (" << o.controllers << ")" << std::endl;
+  }
   std::vector<server::StaticAsset> console;
   for (const auto& f : web::embedded_files()) {
     console.push_back({f.path, {reinterpret_cast<const char*>(f.data), f.size}});
@@ -225,6 +244,9 @@ void register_serve_command(CLI::App& app) {
       ->check(CLI::Range(0, 19))
       ->capture_default_str();
   add_planner_graph_option(*cmd, o->planner_graph);
+  cmd->add_option("--controllers", o->controllers,
+                  "JSON file of field signal controllers driven over NTCIP 1202 (SNMP): per intersection its address, SNMP "
+                  "version and credentials, and preempt or phase-control wiring (docs/field.md); a signal-agent manifest is one");
   cmd->add_flag("--route-only", o->route_only,
                 "preempt from the vehicle's predicted arrival alone, without the vicinity rules that read detectors' queues");
   cmd->add_flag("--demo", o->demo,

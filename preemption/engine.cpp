@@ -300,6 +300,7 @@ void PreemptionEngine::refresh_node(NodeId node, double now_s) {
   std::vector<std::uint8_t> want(plan.movements.size(), 0);
   std::string label;
   double min_green = 0.0;
+  HoldRequest request;  // entries are in arbitration order: the highest claim first
   for (ScheduleEntry* e : ns.entries) {
     if (e->start_s > now_s) continue;
     // Arbitration made every overlapping pair compatible, so the union of their phases is safe.
@@ -315,20 +316,29 @@ void PreemptionEngine::refresh_node(NodeId node, double now_s) {
     for (std::size_t m = 0; m < want.size(); ++m) want[m] = want[m] || e->phase.serves(m);
     if (label.find(e->phase.label) == std::string::npos) label += (label.empty() ? "" : "|") + e->phase.label;
     min_green = std::max(min_green, e->phase.min_green_s);
+    for (std::size_t m : e->movements) {
+      if (std::find(request.movements.begin(), request.movements.end(), m) == request.movements.end()) request.movements.push_back(m);
+    }
+    if (std::find(request.missions.begin(), request.missions.end(), e->mission) == request.missions.end()) {
+      request.missions.push_back(e->mission);
+    }
+    request.priority = std::max(request.priority, e->priority);
   }
   const bool any = std::find(want.begin(), want.end(), 1) != want.end();
   if (any) {
     if (ns.red_while_held.empty()) ns.red_while_held.assign(want.size(), 0);
     for (std::size_t m = 0; m < want.size(); ++m) ns.red_while_held[m] = ns.red_while_held[m] || !want[m];
-    if (want != ns.held) {
-      controller_.hold(node, maps::Phase{label, want, min_green}, now_s);
+    if (want != ns.held || request.missions != ns.held_for.missions || request.movements != ns.held_for.movements) {
+      controller_.hold_for(node, maps::Phase{label, want, min_green}, request, now_s);
       ns.held = want;
+      ns.held_for = std::move(request);
     }
   } else if (!ns.held.empty()) {
     const std::size_t step = recovery_step(node, ns, now_s);
     controller_.release(node, step, now_s);
     log(now_s, 0, node, "recovered", "resume_step=" + std::to_string(step));
     ns.held.clear();
+    ns.held_for = {};
     ns.red_while_held.clear();
   }
 }

@@ -149,6 +149,7 @@ class PreemptionEngine {
   struct NodeState {
     std::vector<ScheduleEntry*> entries;       // live (planned or active) entries of all missions
     std::vector<std::uint8_t> held;            // the green set being held; empty when not holding
+    HoldRequest held_for;                      // whom the hold serves
     std::vector<std::uint8_t> red_while_held;  // movements kept red by the holds, for recovery
   };
 

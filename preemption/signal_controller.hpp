@@ -19,6 +19,10 @@ enum class SignalMode : std::uint8_t {
   held,     // preempted: moving to or holding a phase for an emergency vehicle
 };
 
+// Where a hold stands, as a field controller reports its preempt: clearing towards the held phase
+// (entry), its green on show (dwell), or clearing back to the normal program (exit).
+enum class HoldStage : std::uint8_t { none, entering, holding, exiting };
+
 // A stretch of time over which the normal program shows one set of greens, as the controller
 // foresees it: a phase's green, or the clearance between two phases (whose greens are then the
 // movements green on both sides of it).
@@ -30,11 +34,24 @@ struct ProgramInterval {
   double min_green_end_s = 0.0;     // a phase: when its minimum green is served
 };
 
+// Who a hold is for: the movements the vehicles make and the missions whose claims it serves (the
+// highest priority first), so that a field controller can pick the preempt input wired to the
+// vehicle's approach, or priority without preemption, and keep a record of each call.
+struct HoldRequest {
+  std::vector<std::size_t> movements;
+  std::vector<std::uint64_t> missions;
+  int priority = 0;  // the highest of theirs
+};
+
 class SignalController {
  public:
   virtual ~SignalController() = default;
   // Moves to `phase` through safe transitions and holds it until released. Replaces a previous hold.
   virtual void hold(NodeId node, const maps::Phase& phase, double now_s) = 0;
+  // The same, saying whom the hold is for; a controller with no use for it just holds.
+  virtual void hold_for(NodeId node, const maps::Phase& phase, const HoldRequest& /*request*/, double now_s) {
+    hold(node, phase, now_s);
+  }
   // Returns to the normal program through safe transitions, starting at program step `resume_step`.
   virtual void release(NodeId node, std::size_t resume_step, double now_s) = 0;
   [[nodiscard]] virtual SignalMode mode(NodeId node) const = 0;
@@ -52,6 +69,12 @@ class SignalController {
                                                                       double /*horizon_s*/) const {
     return {};
   }
+  // Where the hold stands; controllers that cannot tell answer from mode() alone.
+  [[nodiscard]] virtual HoldStage hold_stage(NodeId node) const {
+    return mode(node) == SignalMode::held ? HoldStage::holding : HoldStage::none;
+  }
+  // What each movement shows now; empty where the controller cannot tell.
+  [[nodiscard]] virtual std::vector<Light> lights_shown(NodeId /*node*/) const { return {}; }
 };
 
 }  // namespace corridor::preemption

@@ -239,6 +239,13 @@ std::vector<ProgramInterval> SimulatedSignalController::program_forecast(NodeId 
   return out;
 }
 
+HoldStage SimulatedSignalController::hold_stage(NodeId node) const {
+  const State& s = state(node);
+  if (s.mode == SignalMode::held) return s.stage == Stage::green && s.shown == s.held.green ? HoldStage::holding : HoldStage::entering;
+  // Released, and not yet back on a program phase: on the way back.
+  return s.stage == Stage::green && s.shown == desired(s) ? HoldStage::none : HoldStage::exiting;
+}
+
 const std::vector<Light>& SimulatedSignalController::lights(NodeId node) const { return state(node).lights; }
 
 bool SimulatedSignalController::running_program(NodeId node) const {

@@ -31,6 +31,8 @@ class SimulatedSignalController final : public SignalController {
   [[nodiscard]] std::optional<double> green_start_s(NodeId node, std::size_t movement) const override;
   // Exact for the program it runs, from a program phase on show or a program clearance.
   [[nodiscard]] std::vector<ProgramInterval> program_forecast(NodeId node, double now_s, double horizon_s) const override;
+  [[nodiscard]] HoldStage hold_stage(NodeId node) const override;
+  [[nodiscard]] std::vector<Light> lights_shown(NodeId node) const override { return lights(node); }
 
   [[nodiscard]] const std::vector<Light>& lights(NodeId node) const;
   // True while nothing is being cleared and the program's own phase is on show.

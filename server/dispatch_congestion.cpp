@@ -260,7 +260,9 @@ void DispatchService::tick(double now_s) {
     std::lock_guard lock(preemption_mutex_);
     signals_.advance(now_s);
     preemption_.tick(now_s);
+    if (field_) field_->tick(now_s);
     drain_preemption_events(staged);
+    drain_call_records(staged);
     // Recovery ends inside the signals' own clock, without an engine event.
     for (const auto& [node, plan] : signals_map_.signals) announce_signal_state(node, now_s);
   }

@@ -80,7 +80,13 @@ DispatchService::DispatchService(const maps::RoadGraph& graph, maps::SignalMap s
       signals_map_(std::move(signals)),
       overlay_(graph),
       signals_(signals_map_.signals, now_s),
-      preemption_(graph, signals_map_.signals, signals_, config.preemption) {
+      field_(config.field_controllers.empty()
+                 ? nullptr
+                 : std::make_unique<ntcip::FieldSignalController>(graph, signals_map_, config.field_controllers, [] {
+                     return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+                   })),
+      routed_(signals_, field_.get()),
+      preemption_(graph, signals_map_.signals, routed_, config.preemption) {
   preemption_.set_signal_nodes(signals_map_.signal_of);
   if (config_.repair_threads < 1 || config_.repair_threads > 64) {
     throw std::invalid_argument("repair_threads must be 1 to 64, not " + std::to_string(config_.repair_threads));

@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <deque>
 #include <functional>
 #include <map>
 #include <memory>
@@ -19,12 +20,15 @@
 #include "maps/signal_map.hpp"
 #include "planner/dstar_lite.hpp"
 #include "preemption/engine.hpp"
+#include "ntcip/controllers_file.hpp"
+#include "ntcip/field_signals.hpp"
 #include "preemption/simulated_signal_controller.hpp"
 #include "server/api_error.hpp"
 #include "server/commit_queue.hpp"
 #include "server/dispatch_types.hpp"
 #include "server/json_codec.hpp"
 #include "server/mission_planner.hpp"
+#include "server/routed_signals.hpp"
 #include "server/shared_hierarchy.hpp"
 #include "server/store.hpp"
 #include "server/vehicle_tracker.hpp"
@@ -92,6 +96,9 @@ struct DispatchConfig {
   // 54 bytes per arc (67 MB on Porto); top speeds are the client's to choose.
   int max_hierarchy_models = 4;
   preemption::PreemptionConfig preemption;
+  // Signals driven in the field over NTCIP 1202 (corridor serve --controllers); the others run in
+  // memory. Validated against the map when the service starts.
+  std::vector<ntcip::ControllerConfig> field_controllers;
 };
 
 class DispatchService {
@@ -135,6 +142,12 @@ class DispatchService {
   [[nodiscard]] const std::unordered_map<NodeId, maps::SignalPlan>& signal_plans() const { return signals_map_.signals; }
   // The SUMO tls id of a signal, empty on an OSM map.
   [[nodiscard]] std::string signal_name(NodeId signal) const;
+  // The field controller's report and link of a signal driven over NTCIP; nullopt for the others.
+  [[nodiscard]] std::optional<ntcip::FieldStatus> field_status(NodeId signal) const;
+  // Call records on field controllers, newest first: of one signal (404 for one that is not a
+  // signal), or of one mission (404 for an unknown one), at most `limit`.
+  [[nodiscard]] std::vector<SignalCallRow> signal_calls(NodeId signal, std::size_t limit);
+  [[nodiscard]] std::vector<SignalCallRow> mission_calls(MissionId mission, std::size_t limit);
   [[nodiscard]] std::vector<preemption::Light> signal_lights(NodeId node) const;
   // "held" (for an emergency vehicle), "clearing" (yellow and all-red on the way back) or
   // "program", and the program step; a simulator mirrors these onto its own lights.
@@ -185,6 +198,8 @@ class DispatchService {
   void repair_one(Mission& m, double now_s, CongestionResult& result, std::vector<std::shared_ptr<CommitTicket>>& durable);
   // Under preemption_mutex_.
   void drain_preemption_events(Staged& staged);
+  // Under preemption_mutex_: the field controllers' changed call records, stored and announced.
+  void drain_call_records(Staged& staged);
   void emit(DispatchEvent event);
   // Under preemption_mutex_: emits signal_state when the signal's state changed since last said.
   void announce_signal_state(NodeId node, double now_s);
@@ -238,7 +253,10 @@ class DispatchService {
   // The signals and the engine that arbitrates between missions.
   mutable std::mutex preemption_mutex_;
   preemption::SimulatedSignalController signals_;
+  std::unique_ptr<ntcip::FieldSignalController> field_;  // null without field controllers
+  RoutedSignals routed_;
   preemption::PreemptionEngine preemption_;
+  std::deque<SignalCallRow> recent_calls_;  // without a store: the latest call records
   std::unordered_map<NodeId, std::string> shown_signal_state_;  // last announced signal_state
 
   mutable std::shared_mutex registry_mutex_;

@@ -7,10 +7,24 @@
 #include <cmath>
 
 #include "preemption/queue_estimator.hpp"
+#include "server/dispatch_mission.hpp"
+
+#include <algorithm>
+#include <shared_mutex>
 
 namespace corridor::server {
 
 std::string DispatchService::signal_state_locked(NodeId node) const {
+  if (routed_.in_field(node)) {
+    // What the field controller reports of its preempt.
+    switch (field_->hold_stage(node)) {
+      case preemption::HoldStage::entering:
+      case preemption::HoldStage::holding: return "held";
+      case preemption::HoldStage::exiting: return "recovering";
+      case preemption::HoldStage::none: break;
+    }
+    return preemption_.planned(node) ? "scheduled" : "normal";
+  }
   if (signals_.mode(node) == preemption::SignalMode::held) return "held";
   // The program passes through yellow and all-red between its own steps too; it is recovering
   // only on its way back from a hold, until its own phase is on show again.
@@ -93,12 +107,94 @@ void DispatchService::report_detectors(NodeId stop_line, const CountsReport& rep
 std::vector<preemption::Light> DispatchService::signal_lights(NodeId node) const {
   if (signals_map_.signals.count(node) == 0) throw not_found("no signal at node " + std::to_string(node.v));
   std::lock_guard lock(preemption_mutex_);
+  // A field controller's own report where its phases are wired; the in-memory program otherwise.
+  if (routed_.in_field(node)) {
+    auto lights = field_->lights_shown(node);
+    if (!lights.empty()) return lights;
+  }
   return signals_.lights(node);
+}
+
+std::optional<ntcip::FieldStatus> DispatchService::field_status(NodeId signal) const {
+  if (!field_) return std::nullopt;
+  return field_->status(signal);
+}
+
+void DispatchService::drain_call_records(Staged& staged) {
+  if (!field_) return;
+  for (const ntcip::CallRecord& c : field_->take_records()) {
+    SignalCallRow row;
+    row.id = c.id;
+    row.signal = c.signal;
+    row.controller = c.controller;
+    row.missions.assign(c.missions.begin(), c.missions.end());
+    if (!c.missions.empty()) {
+      row.mission = c.missions.front();
+      std::shared_lock registry(registry_mutex_);
+      if (const auto it = missions_.find(c.missions.front()); it != missions_.end()) row.vehicle_id = it->second->row.vehicle_id;
+    }
+    row.priority = c.priority;
+    row.kind = c.kind;
+    row.preempt = c.preempt;
+    row.approach = c.approach;
+    row.request_s = c.request_s;
+    row.grant_s = c.grant_s;
+    row.release_s = c.release_s;
+    row.clear_s = c.clear_s;
+    row.outcome = c.outcome;
+    stage(staged, [row](Store& store) { store.upsert_signal_call(row); });
+    // The latest state of each record, for a server without a store.
+    const auto same = std::find_if(recent_calls_.begin(), recent_calls_.end(), [&](const SignalCallRow& r) { return r.id == row.id; });
+    if (same != recent_calls_.end()) {
+      *same = row;
+    } else {
+      recent_calls_.push_front(row);
+      if (recent_calls_.size() > 2000) recent_calls_.pop_back();
+    }
+    DispatchEvent e;
+    e.kind = "signal_call";
+    e.mission = row.mission.value_or(0);
+    e.signal = row.signal;
+    e.vehicle_id = row.vehicle_id;
+    e.state = row.outcome;
+    e.reason = row.kind + (row.kind == "preempt" ? " " + std::to_string(row.preempt) : std::string{}) + " approach=" + row.approach;
+    e.time_s = row.clear_s.value_or(row.release_s.value_or(row.grant_s.value_or(row.request_s)));
+    emit(std::move(e));
+  }
+}
+
+std::vector<SignalCallRow> DispatchService::signal_calls(NodeId signal, std::size_t limit) {
+  if (signals_map_.signals.count(signal) == 0) throw not_found("no signal at node " + std::to_string(signal.v));
+  if (store_ != nullptr) {
+    flush();  // what has been announced is also what is read
+    return store_->signal_calls(signal, std::nullopt, limit);
+  }
+  std::lock_guard lock(preemption_mutex_);
+  std::vector<SignalCallRow> out;
+  for (const auto& r : recent_calls_) {
+    if (r.signal == signal && out.size() < limit) out.push_back(r);
+  }
+  return out;
+}
+
+std::vector<SignalCallRow> DispatchService::mission_calls(MissionId mission, std::size_t limit) {
+  (void)this->mission(mission);  // 404 for an unknown mission
+  if (store_ != nullptr) {
+    flush();
+    return store_->signal_calls(std::nullopt, mission, limit);
+  }
+  std::lock_guard lock(preemption_mutex_);
+  std::vector<SignalCallRow> out;
+  for (const auto& r : recent_calls_) {
+    if (std::find(r.missions.begin(), r.missions.end(), mission) != r.missions.end() && out.size() < limit) out.push_back(r);
+  }
+  return out;
 }
 
 std::pair<std::string, std::size_t> DispatchService::signal_mode(NodeId node) const {
   if (signals_map_.signals.count(node) == 0) throw not_found("no signal at node " + std::to_string(node.v));
   std::lock_guard lock(preemption_mutex_);
+  if (routed_.in_field(node)) return {field_->mode(node) == preemption::SignalMode::held ? "held" : "program", 0};
   const char* mode = signals_.mode(node) == preemption::SignalMode::held ? "held"
                      : signals_.running_program(node)                    ? "program"
                                                                          : "clearing";

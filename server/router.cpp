@@ -1,5 +1,7 @@
 #include "server/router.hpp"
 
+#include <fmt/format.h>
+
 #include <spdlog/spdlog.h>
 
 #include <chrono>
@@ -267,8 +269,68 @@ Router::Router(DispatchService& service, TokenAuth auth, RouterConfig config, Cl
              {"phases", std::move(phases)}, {"lights", std::move(lights)},
              {"mode", mode}, {"program_step", step}, {"state", service_.signal_state(n)}};
     if (const std::string name = service_.signal_name(n); !name.empty()) out["tls_id"] = name;
+    if (const auto field = service_.field_status(n)) {
+      json f{{"controller", field->controller}, {"link", ntcip::to_string(field->link)}, {"call_on", field->call_on},
+             {"lights_reported", !field->lights.empty()}};
+      if (field->last_answer_s) f["last_answer_s"] = *field->last_answer_s;
+      if (!field->last_error.empty()) f["error"] = field->last_error;
+      if (field->preempt != 0) f["preempt"] = field->preempt;
+      if (field->preempt_state) f["preempt_state"] = ntcip::to_string(*field->preempt_state);
+      out["field"] = std::move(f);
+    }
     return out;
   };
+  const auto calls_response = [this](const std::vector<SignalCallRow>& calls, const Match& m) {
+    const auto format = m.query.find("format");
+    if (format != m.query.end() && format->second == "csv") {
+      std::string csv = "id,signal,controller,mission_id,vehicle_id,priority,kind,preempt,approach,request_s,grant_s,release_s,clear_s,outcome\n";
+      const auto t = [](std::optional<double> v) { return v ? fmt::format("{:.3f}", *v) : std::string{}; };
+      const auto quoted = [](const std::string& v) {
+        if (v.find_first_of(",\"\r\n") == std::string::npos) return v;
+        std::string q = "\"";
+        for (char c : v) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+        return q + "\"";
+      };
+      for (const auto& c : calls) {
+        csv += fmt::format("{},{},{},{},{},{},{},{},{},{:.3f},{},{},{},{}\n", c.id, c.signal.v, quoted(c.controller),
+                           c.mission ? std::to_string(*c.mission) : std::string{}, quoted(c.vehicle_id), c.priority, c.kind, c.preempt,
+                           c.approach, c.request_s, t(c.grant_s), t(c.release_s), t(c.clear_s), c.outcome);
+      }
+      return HttpResponse{200, "text/csv; charset=utf-8", std::move(csv), nullptr, {}};
+    }
+    if (format != m.query.end() && format->second != "json") throw bad_request("format must be json or csv");
+    json list = json::array();
+    for (const auto& c : calls) {
+      json j{{"id", c.id}, {"signal", c.signal.v}, {"controller", c.controller}, {"vehicle_id", c.vehicle_id},
+             {"missions", c.missions}, {"priority", c.priority}, {"kind", c.kind}, {"approach", c.approach},
+             {"request_s", c.request_s}, {"outcome", c.outcome}};
+      if (c.mission) j["mission_id"] = *c.mission;
+      if (c.kind == "preempt") j["preempt"] = c.preempt;
+      if (c.grant_s) j["grant_s"] = *c.grant_s;
+      if (c.release_s) j["release_s"] = *c.release_s;
+      if (c.clear_s) j["clear_s"] = *c.clear_s;
+      list.push_back(std::move(j));
+    }
+    return json_response(200, {{"calls", std::move(list)}});
+  };
+  const auto calls_limit = [](const Match& m) {
+    const auto it = m.query.find("limit");
+    if (it == m.query.end()) return std::size_t{200};
+    const auto n = parse_id(it->second, "limit");
+    if (n < 1 || n > 10000) throw bad_request("limit must be 1..10000");
+    return static_cast<std::size_t>(n);
+  };
+  add("GET", "/v1/signals/{id}/calls", kRead,
+      "Call records of a field-controlled signal, newest first (?limit=N, ?format=csv): request, grant, release, clear, outcome",
+      [this, calls_response, calls_limit](const Principal&, const Match& m, const HttpRequest&) {
+        const auto id = parse_id(m.params[0], "signal id");
+        if (id >= service_.graph().node_count()) throw not_found("no signal " + m.params[0]);
+        return calls_response(service_.signal_calls(NodeId{static_cast<std::uint32_t>(id)}, calls_limit(m)), m);
+      }, kBlocking);
+  add("GET", "/v1/missions/{id}/calls", kRead, "Call records of a mission's signals on field controllers (?limit=N, ?format=csv)",
+      [this, calls_response, calls_limit](const Principal&, const Match& m, const HttpRequest&) {
+        return calls_response(service_.mission_calls(parse_id(m.params[0], "mission id"), calls_limit(m)), m);
+      }, kBlocking);
   add("GET", "/v1/signals", kRead, "Every signalized intersection", [this, signal_json](const Principal&, const Match&, const HttpRequest&) {
     json list = json::array();
     std::vector<NodeId> ids;

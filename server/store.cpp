@@ -1,5 +1,7 @@
 #include "server/store.hpp"
 
+#include "server/sqlite_statement.hpp"
+
 #include <fcntl.h>
 #include <spdlog/spdlog.h>
 #include <sqlite3.h>
@@ -18,7 +20,7 @@ namespace corridor::server {
 namespace {
 
 // Each entry moves the schema one version up; never edit a released entry, append a new one.
-constexpr std::array<const char*, 4> kMigrations{
+constexpr std::array<const char*, 5> kMigrations{
     R"sql(
     CREATE TABLE missions (
       id INTEGER PRIMARY KEY AUTOINCREMENT,
@@ -88,61 +90,27 @@ constexpr std::array<const char*, 4> kMigrations{
     R"sql(
     ALTER TABLE missions ADD COLUMN profile TEXT NOT NULL DEFAULT 'ambulance';
     )sql",
-};
-
-class Statement {
- public:
-  Statement(sqlite3* db, const char* sql) : owned_(true) {
-    if (sqlite3_prepare_v2(db, sql, -1, &stmt_, nullptr) != SQLITE_OK) {
-      throw StoreError(std::string("cannot prepare statement: ") + sqlite3_errmsg(db));
-    }
-  }
-  // Borrows a prepared statement from the store's cache and resets it for the next user.
-  explicit Statement(sqlite3_stmt* cached) : stmt_(cached), owned_(false) {}
-  ~Statement() {
-    if (owned_) {
-      sqlite3_finalize(stmt_);
-    } else {
-      sqlite3_reset(stmt_);
-      sqlite3_clear_bindings(stmt_);
-    }
-  }
-  Statement(const Statement&) = delete;
-  Statement& operator=(const Statement&) = delete;
-
-  Statement& bind(int i, double v) { return check(sqlite3_bind_double(stmt_, i, v)); }
-  Statement& bind(int i, std::int64_t v) { return check(sqlite3_bind_int64(stmt_, i, v)); }
-  Statement& bind(int i, const std::string& v) {
-    return check(sqlite3_bind_text(stmt_, i, v.c_str(), static_cast<int>(v.size()), SQLITE_TRANSIENT));
-  }
-  Statement& bind(int i, std::optional<double> v) {
-    return v && std::isfinite(*v) ? bind(i, *v) : check(sqlite3_bind_null(stmt_, i));
-  }
-  // True while rows come; throws on error.
-  bool step() {
-    const int rc = sqlite3_step(stmt_);
-    if (rc == SQLITE_ROW) return true;
-    if (rc == SQLITE_DONE) return false;
-    throw StoreError(std::string("database write failed: ") + sqlite3_errmsg(sqlite3_db_handle(stmt_)));
-  }
-  [[nodiscard]] double real(int col) const { return sqlite3_column_double(stmt_, col); }
-  [[nodiscard]] std::int64_t integer(int col) const { return sqlite3_column_int64(stmt_, col); }
-  [[nodiscard]] bool null(int col) const { return sqlite3_column_type(stmt_, col) == SQLITE_NULL; }
-  [[nodiscard]] std::optional<double> optional_real(int col) const {
-    return null(col) ? std::nullopt : std::optional<double>(real(col));
-  }
-  [[nodiscard]] std::string text(int col) const {
-    const auto* p = sqlite3_column_text(stmt_, col);
-    return p == nullptr ? std::string{} : std::string(reinterpret_cast<const char*>(p));
-  }
-
- private:
-  Statement& check(int rc) {
-    if (rc != SQLITE_OK) throw StoreError("cannot bind statement parameter");
-    return *this;
-  }
-  sqlite3_stmt* stmt_ = nullptr;
-  bool owned_;
+    // v5: call records of the field controllers (store_calls.cpp), as field systems keep them.
+    R"sql(
+    CREATE TABLE signal_calls (
+      id INTEGER PRIMARY KEY,
+      signal INTEGER NOT NULL,
+      controller TEXT NOT NULL,
+      mission_id INTEGER,
+      vehicle_id TEXT,
+      missions TEXT NOT NULL,
+      priority INTEGER NOT NULL,
+      kind TEXT NOT NULL,
+      preempt INTEGER NOT NULL,
+      approach TEXT NOT NULL,
+      request_s REAL NOT NULL,
+      grant_s REAL,
+      release_s REAL,
+      clear_s REAL,
+      outcome TEXT NOT NULL);
+    CREATE INDEX signal_calls_signal ON signal_calls(signal, id);
+    CREATE INDEX signal_calls_mission ON signal_calls(mission_id, id);
+    )sql",
 };
 
 }  // namespace
@@ -486,7 +454,7 @@ std::vector<CongestionRow> Store::congestion_in_force(double now_s) const {
 }
 
 std::size_t Store::count(const std::string& table) const {
-  for (const char* allowed : {"missions", "positions", "route_revisions", "congestion", "preemption_events"}) {
+  for (const char* allowed : {"missions", "positions", "route_revisions", "congestion", "preemption_events", "signal_calls"}) {
     if (table == allowed) {
       Statement s(db_, ("SELECT COUNT(*) FROM " + table).c_str());
       s.step();

@@ -55,6 +55,25 @@ struct CongestionRow {
   std::optional<double> expires_at_s;
 };
 
+// One call on a field signal controller (ntcip::CallRecord), with the vehicle of its first mission.
+struct SignalCallRow {
+  std::uint64_t id = 0;
+  NodeId signal;
+  std::string controller;
+  std::optional<MissionId> mission;  // the highest-priority mission it served
+  std::string vehicle_id;
+  std::vector<MissionId> missions;
+  int priority = 0;
+  std::string kind;  // preempt, phase_control
+  std::uint32_t preempt = 0;
+  std::string approach;
+  double request_s = 0.0;
+  std::optional<double> grant_s;
+  std::optional<double> release_s;
+  std::optional<double> clear_s;
+  std::string outcome;
+};
+
 enum class Durability {
   process_crash,  // synchronous=NORMAL: survives kill -9, not power loss
   power_loss,     // synchronous=FULL
@@ -97,6 +116,8 @@ class Store {
   void insert_congestion(EdgeId edge, const planner::EdgeCondition& condition, std::optional<double> expires_at_s,
                          double time_s);
   void insert_preemption_event(const preemption::PreemptionEvent& event);
+  // A call record as it stands now (a later write of the same id replaces it).
+  void upsert_signal_call(const SignalCallRow& row);
 
   [[nodiscard]] std::vector<MissionRow> missions(std::optional<MissionState> state) const;
   [[nodiscard]] std::optional<PositionRow> last_position(const std::string& vehicle_id) const;
@@ -108,6 +129,9 @@ class Store {
   // The latest condition of every edge whose latest update has not expired by `now_s`.
   [[nodiscard]] std::vector<CongestionRow> congestion_in_force(double now_s) const;
   [[nodiscard]] std::size_t count(const std::string& table) const;
+  // Call records, newest first, of one signal or one mission (or all), at most `limit`.
+  [[nodiscard]] std::vector<SignalCallRow> signal_calls(std::optional<NodeId> signal, std::optional<MissionId> mission,
+                                                        std::size_t limit) const;
 
  private:
   void exec(const std::string& sql) const;

@@ -110,6 +110,11 @@ struct CollisionRecord {
   std::string tls;             // the light over the junction, if any
   char collider_light = '-';   // the state of the collider's link ('G', 'g', 'y', 'r'), '-' off a light
   char victim_light = '-';
+  std::string collider_lane;   // where each was at the step of the collision
+  std::string victim_lane;
+  int collider_link = -1;      // the light's link each was taking, -1 off a light
+  int victim_link = -1;
+  bool links_conflict = false;  // the two links are foes under the light (false for one link, or none)
   bool held_by_corridor = false;  // the light was taken over by Corridor's controller then
   bool ev_involved = false;
 };

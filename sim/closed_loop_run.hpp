@@ -286,31 +286,37 @@ ClosedLoopResult run_loop(const SumoScenario& scenario, const ClosedLoopConfig& 
         r.kind = c.type;
         r.lane = c.lane;
         r.ev_involved = c.collider.rfind(kEv, 0) == 0 || c.victim.rfind(kEv, 0) == 0;
-        const auto light_of = [&](const std::string& vehicle, char& light) {
+        const auto light_of = [&](const std::string& vehicle, char& light, std::string& lane, int& link_index) {
           try {
-            const std::string lane = Api::Vehicle::getLaneID(vehicle);
+            lane = Api::Vehicle::getLaneID(vehicle);
             const std::vector<std::string> route = Api::Vehicle::getRoute(vehicle);
             const auto index = static_cast<std::size_t>(std::max(0, Api::Vehicle::getRouteIndex(vehicle)));
             const auto link = link_of_lane(scenario, lane, index + 1 < route.size() ? route[index + 1] : std::string{});
             if (!link) return;
             r.tls = link->tls;
+            link_index = link->link_index;
             const std::string state = Api::TrafficLight::getRedYellowGreenState(link->tls);
             if (link->link_index >= 0 && static_cast<std::size_t>(link->link_index) < state.size()) light = state[static_cast<std::size_t>(link->link_index)];
           } catch (const libsumo::TraCIException&) {
             // The vehicle is gone (teleported or removed): its light is not known.
           }
         };
-        light_of(c.collider, r.collider_light);
-        light_of(c.victim, r.victim_light);
+        light_of(c.collider, r.collider_light, r.collider_lane, r.collider_link);
+        light_of(c.victim, r.victim_light, r.victim_lane, r.victim_link);
         if (!r.tls.empty()) {
           for (const auto& [node, plan] : scenario.signal_plans) {
-            if (scenario.sumo_plan_of.at(node)->tls_id == r.tls) r.held_by_corridor = controller.mode(node) == preemption::SignalMode::held;
+            if (scenario.sumo_plan_of.at(node)->tls_id != r.tls) continue;
+            r.held_by_corridor = controller.mode(node) == preemption::SignalMode::held;
+            const auto n = static_cast<int>(plan.movements.size());
+            if (r.collider_link >= 0 && r.victim_link >= 0 && r.collider_link < n && r.victim_link < n && r.collider_link != r.victim_link) {
+              r.links_conflict = plan.conflicts(static_cast<std::size_t>(r.collider_link), static_cast<std::size_t>(r.victim_link));
+            }
           }
         }
-        spdlog::info("event=collision t={:.0f} collider={} ({}) victim={} ({}) kind={} lane={} tls={} collider_light={} "
-                     "victim_light={} held_by_corridor={}",
+        spdlog::info("event=collision t={:.0f} collider={} ({}) victim={} ({}) kind={} lane={} tls={} collider_link={} ({}) "
+                     "victim_link={} ({}) links_conflict={} held_by_corridor={}",
                      t, r.collider, r.collider_type, r.victim, r.victim_type, r.kind, r.lane, r.tls.empty() ? "-" : r.tls,
-                     r.collider_light, r.victim_light, r.held_by_corridor);
+                     r.collider_link, r.collider_light, r.victim_link, r.victim_light, r.links_conflict, r.held_by_corridor);
         result.collision_records.push_back(std::move(r));
       }
     }

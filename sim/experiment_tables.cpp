@@ -343,10 +343,16 @@ ExperimentTables write_experiment_tables(std::vector<PlannedRecord> runs, const 
   std::string collisions;
   for (const ExperimentRow& row : rows) {
     for (const CollisionRecord& c : row.run.result.collision_records) {
-      collisions += fmt::format("- {}, t={:.0f} s: {} ({}) into {} ({}), {} on {}{}; lights: {} {}, {} {}{}\n", run_name(row.run),
-                                c.time_s, c.collider, c.collider_type, c.victim, c.victim_type, c.kind, c.lane,
-                                c.tls.empty() ? "" : " under light " + c.tls, c.collider, c.collider_light, c.victim,
-                                c.victim_light, c.held_by_corridor ? "; the light was held by Corridor" : "");
+      const std::string links =
+          c.collider_link < 0 || c.victim_link < 0 ? std::string("")
+          : c.collider_link == c.victim_link      ? fmt::format(", both on link {}", c.collider_link)
+                                                  : fmt::format(", links {} and {} ({})", c.collider_link, c.victim_link,
+                                                                c.links_conflict ? "foes" : "not foes");
+      collisions += fmt::format("- {}, t={:.0f} s: {} ({}, {}) into {} ({}, {}), {} on {}{}; lights: {} {}, {} {}{}{}\n",
+                                run_name(row.run), c.time_s, c.collider, c.collider_type, c.collider_lane, c.victim,
+                                c.victim_type, c.victim_lane, c.kind, c.lane, c.tls.empty() ? "" : " under light " + c.tls,
+                                c.collider, c.collider_light, c.victim, c.victim_light, links,
+                                c.held_by_corridor ? "; the light was held by Corridor" : "");
     }
   }
   if (!collisions.empty()) md += "\nCollisions, each traced to the light over it:\n\n" + collisions;

@@ -16,7 +16,9 @@ inline void to_json(nlohmann::json& j, const CollisionRecord& c) {
   j = {{"time_s", c.time_s}, {"collider", c.collider}, {"victim", c.victim}, {"collider_type", c.collider_type},
        {"victim_type", c.victim_type}, {"kind", c.kind}, {"lane", c.lane}, {"tls", c.tls},
        {"collider_light", std::string(1, c.collider_light)}, {"victim_light", std::string(1, c.victim_light)},
-       {"held_by_corridor", c.held_by_corridor}, {"ev_involved", c.ev_involved}};
+       {"held_by_corridor", c.held_by_corridor}, {"ev_involved", c.ev_involved}, {"collider_lane", c.collider_lane},
+       {"victim_lane", c.victim_lane}, {"collider_link", c.collider_link}, {"victim_link", c.victim_link},
+       {"links_conflict", c.links_conflict}};
 }
 inline void from_json(const nlohmann::json& j, CollisionRecord& c) {
   c.time_s = j.value("time_s", 0.0);
@@ -35,6 +37,11 @@ inline void from_json(const nlohmann::json& j, CollisionRecord& c) {
   c.victim_light = light("victim_light");
   c.held_by_corridor = j.value("held_by_corridor", false);
   c.ev_involved = j.value("ev_involved", false);
+  c.collider_lane = j.value("collider_lane", std::string{});
+  c.victim_lane = j.value("victim_lane", std::string{});
+  c.collider_link = j.value("collider_link", -1);
+  c.victim_link = j.value("victim_link", -1);
+  c.links_conflict = j.value("links_conflict", false);
 }
 
 // With defaults: a record written before a key existed still reads.

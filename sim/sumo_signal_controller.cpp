@@ -375,6 +375,31 @@ std::vector<preemption::ProgramInterval> SumoSignalController::program_forecast(
   return out;
 }
 
+preemption::HoldStage SumoSignalController::hold_stage(NodeId node) const {
+  const Light& l = light(node);
+  switch (l.stage) {
+    case Stage::program: return preemption::HoldStage::none;
+    case Stage::clear_yellow:
+    case Stage::clear_all_red: return preemption::HoldStage::entering;
+    case Stage::held:
+      if (l.release_pending) return preemption::HoldStage::exiting;
+      return l.held_since_s >= 0.0 ? preemption::HoldStage::holding : preemption::HoldStage::entering;
+    case Stage::back_yellow:
+    case Stage::back_all_red: return preemption::HoldStage::exiting;
+  }
+  return preemption::HoldStage::none;
+}
+
+std::vector<preemption::Light> SumoSignalController::lights_shown(NodeId node) const {
+  const Light& l = light(node);
+  const std::string state = l.stage == Stage::program ? api_.state(l.tls) : l.shown;
+  std::vector<preemption::Light> out(state.size(), preemption::Light::red);
+  for (std::size_t i = 0; i < state.size(); ++i) {
+    out[i] = is_green(state[i]) ? preemption::Light::green : is_yellow(state[i]) ? preemption::Light::yellow : preemption::Light::red;
+  }
+  return out;
+}
+
 std::size_t SumoSignalController::lights_taken_over() const {
   return static_cast<std::size_t>(std::count_if(lights_.begin(), lights_.end(), [](const auto& kv) { return kv.second.taken_over; }));
 }

@@ -50,6 +50,8 @@ class SumoSignalController final : public preemption::SignalController {
   // phase on show can be of an actuated one.
   [[nodiscard]] std::vector<preemption::ProgramInterval> program_forecast(NodeId node, double now_s,
                                                                           double horizon_s) const override;
+  [[nodiscard]] preemption::HoldStage hold_stage(NodeId node) const override;
+  [[nodiscard]] std::vector<preemption::Light> lights_shown(NodeId node) const override;
 
   // Breaches of the safety rules in the states this controller set; empty when all held.
   [[nodiscard]] const std::vector<std::string>& violations() const { return violations_; }

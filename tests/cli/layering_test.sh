@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Module dependencies point one way: maps <- planner <- preemption <- sim/server; maps <- planner
-# <- localizer <- sim/server.
+# <- localizer <- sim/server. The field interfaces are modules of their own below sim and server:
+# ntcip (signal controllers over SNMP) behind preemption's SignalController, gnss (receivers via
+# gpsd) behind the localizer's fixes.
 # A module may include only itself and the modules below it. Usage: layering_test.sh SOURCE_DIR
 set -euo pipefail
 cd "$1"
@@ -8,10 +10,12 @@ declare -A allowed=(
   [maps]="maps"
   [planner]="maps planner"
   [preemption]="maps planner preemption"
-  [sim]="maps planner preemption localizer sim"
-  [server]="maps planner preemption localizer server"
+  [ntcip]="maps planner preemption ntcip"
+  [gnss]="maps planner localizer gnss"
+  [sim]="maps planner preemption localizer ntcip gnss sim"
+  [server]="maps planner preemption localizer ntcip server"
   [localizer]="maps planner localizer"
-  [bench]="maps planner preemption server bench"
+  [bench]="maps planner preemption localizer ntcip server bench"
   [web]="web"
 )
 violations=0
