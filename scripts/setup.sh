@@ -9,6 +9,7 @@ packages=(
   libgeographiclib-dev libcli11-dev libspdlog-dev libfmt-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libopencv-dev libeigen3-dev libceres-dev libmetis-dev
+  libsnmp-dev snmp libgps-dev gpsd gpsd-clients
   osmium-tool sumo sumo-tools python3 curl parallel
   chromium
 )
