@@ -38,6 +38,7 @@ struct FieldSignalController::Field {
   double last_assert_s = -1e18;
   double last_poll_s = -1e18;
   bool in_flight = false;        // a request is outstanding: no second one piles up behind it
+  double in_flight_since_s = 0.0;
   bool startup_checked = false;  // every wired call read once, and any on cleared
 
   // What the controller reports.
@@ -55,6 +56,8 @@ struct FieldSignalController::Field {
   std::string last_error;
 
   std::optional<CallRecord> call;
+  std::vector<double> rtt_ms;  // a ring of the last answers' round trips
+  std::size_t answers = 0;
   bool unreachable_during_call = false;
   bool max_presence_seen = false;
 };
@@ -330,8 +333,18 @@ void FieldSignalController::update_call(Field& f, double now_s) {
   }
 }
 
-void FieldSignalController::on_reply(Field& f, const SnmpReply& r, double now_s) {
+void FieldSignalController::on_reply(Field& f, const SnmpReply& r, double now_s, double sent_s) {
   f.in_flight = false;
+  if (r.outcome == SnmpReply::Outcome::ok || r.outcome == SnmpReply::Outcome::error_status) {
+    constexpr std::size_t kRing = 4096;
+    const double rtt = std::max(0.0, now_s - sent_s) * 1e3;
+    if (f.rtt_ms.size() < kRing) {
+      f.rtt_ms.push_back(rtt);
+    } else {
+      f.rtt_ms[f.answers % kRing] = rtt;
+    }
+    ++f.answers;
+  }
   if (r.outcome == SnmpReply::Outcome::timeout || r.outcome == SnmpReply::Outcome::failure) {
     ++f.failures;
     const LinkState before = f.link;
@@ -400,24 +413,29 @@ void FieldSignalController::tick(double now_s) {
   std::lock_guard lock(mutex_);
   for (auto& [key, fp] : fields_) {
     Field& f = *fp;
+    // A request the library never answered (it always should: an answer or a timeout) is given up
+    // well after its last try, so that the controller is not stuck.
+    if (f.in_flight && now_s - f.in_flight_since_s > f.config.timeout_s * (f.config.retries + 1) + 5.0) {
+      spdlog::warn("event=ntcip_request_lost controller={}", f.config.id);
+      on_reply(f, SnmpReply{SnmpReply::Outcome::timeout, 0, 0, "no answer (request lost)", {}}, now_s, now_s);
+    }
     if (f.in_flight || now_s < f.next_try_s) continue;
-    const auto done = [this, &f](const SnmpReply& r) {
+    f.in_flight_since_s = now_s;
+    const double sent = clock_();
+    const auto done = [this, &f, sent](const SnmpReply& r) {
       std::lock_guard l(mutex_);
-      on_reply(f, r, clock_());
+      on_reply(f, r, clock_(), sent);
     };
     if (!f.startup_checked) {
       // Any call a previous run left on (it was killed mid-hold) is cleared before anything else.
       std::vector<Oid> read;
       for (const PreemptWiring& p : f.config.preempts) read.push_back(column(oid::kPreemptControlState, p.number));
       f.in_flight = true;
-      snmp_->get(f.session, read, [this, &f](const SnmpReply& r) {
+      snmp_->get(f.session, read, [this, &f, sent](const SnmpReply& r) {
         std::lock_guard l(mutex_);
         const double now = clock_();
-        if (!r.ok()) {
-          on_reply(f, r, now);
-          return;
-        }
-        on_reply(f, r, now);
+        on_reply(f, r, now, sent);
+        if (!r.ok()) return;
         std::vector<std::pair<Oid, std::int64_t>> off;
         for (const auto& [o, v] : r.values) {
           if (v && *v != 0 && f.want != Field::Want::preempt) off.emplace_back(o, 0);
@@ -440,9 +458,10 @@ void FieldSignalController::tick(double now_s) {
                        o.back());
         }
         f.in_flight = true;
-        snmp_->set(f.session, std::move(off), [this, &f](const SnmpReply& reply) {
+        f.in_flight_since_s = now;
+        snmp_->set(f.session, std::move(off), [this, &f, now](const SnmpReply& reply) {
           std::lock_guard l2(mutex_);
-          on_reply(f, reply, clock_());
+          on_reply(f, reply, clock_(), now);
         });
       });
       continue;
@@ -468,7 +487,7 @@ void FieldSignalController::tick(double now_s) {
       f.in_flight = true;
       f.last_assert_s = now_s;
       const std::uint32_t asserted = f.want == Field::Want::preempt ? f.want_preempt : 0;
-      snmp_->set(f.session, std::move(writes), [this, &f, asserted, control_wanted](const SnmpReply& r) {
+      snmp_->set(f.session, std::move(writes), [this, &f, asserted, control_wanted, sent](const SnmpReply& r) {
         std::lock_guard l(mutex_);
         if (r.ok()) {
           f.asserted_preempt = asserted;
@@ -477,7 +496,7 @@ void FieldSignalController::tick(double now_s) {
           // Refused (not writable, wrong value): this call cannot be served here.
           f.call->outcome = "denied";
         }
-        on_reply(f, r, clock_());
+        on_reply(f, r, clock_(), sent);
       });
       continue;
     }
@@ -522,6 +541,14 @@ std::optional<FieldStatus> FieldSignalController::status(NodeId signal) const {
   s.preempt = f.call && f.call->kind == "preempt" ? f.call->preempt : f.want_preempt;
   if (s.preempt != 0 && f.preempt_states.contains(s.preempt)) s.preempt_state = f.preempt_states.at(s.preempt);
   if (f.lights_known) s.lights = f.lights;
+  s.answers = f.answers;
+  if (!f.rtt_ms.empty()) {
+    std::vector<double> sorted = f.rtt_ms;
+    std::sort(sorted.begin(), sorted.end());
+    const auto at = [&](double q) { return sorted[std::min(sorted.size() - 1, static_cast<std::size_t>(q * static_cast<double>(sorted.size())))]; };
+    s.rtt_p50_ms = at(0.5);
+    s.rtt_p99_ms = at(0.99);
+  }
   return s;
 }
 

@@ -60,6 +60,10 @@ struct FieldStatus {
   std::optional<PreemptState> preempt_state;  // the controller's own, for that preempt
   bool call_on = false;       // Corridor wants a call now
   std::vector<preemption::Light> lights;  // as it reports them; empty where its phases are not wired
+  // The round trip of its answered requests (SNMP's cost per command), over the last 4,096.
+  std::size_t answers = 0;
+  std::optional<double> rtt_p50_ms;
+  std::optional<double> rtt_p99_ms;
 };
 
 class FieldSignalController final : public preemption::SignalController {
@@ -100,7 +104,7 @@ class FieldSignalController final : public preemption::SignalController {
   struct Field;
 
  private:
-  void on_reply(Field& f, const SnmpReply& r, double now_s);
+  void on_reply(Field& f, const SnmpReply& r, double now_s, double sent_s);
   void update_call(Field& f, double now_s);
   void touch(Field& f);  // a changed record goes to take_records
   [[nodiscard]] Field& field(NodeId node);

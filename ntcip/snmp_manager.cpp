@@ -24,6 +24,7 @@ constexpr const char* kAppType = "corridor-snmp-manager";
 
 struct Pending {
   SnmpManager::Callback done;
+  std::string note;  // what went wrong on the way, for the final answer
 };
 
 SnmpReply reply_of(netsnmp_pdu* resp) {
@@ -50,15 +51,19 @@ SnmpReply reply_of(netsnmp_pdu* resp) {
 
 int on_reply(int op, netsnmp_session*, int, netsnmp_pdu* resp, void* magic) {
   auto* pending = static_cast<Pending*>(magic);
+  // Only an answer and a timeout end a request: a failed send (a controller whose port answers
+  // with an ICMP "unreachable") is retried by the library and comes back here as a timeout.
+  if (op == NETSNMP_CALLBACK_OP_SEND_FAILED || op == NETSNMP_CALLBACK_OP_SEC_ERROR) {
+    pending->note = op == NETSNMP_CALLBACK_OP_SEND_FAILED ? "sending failed (the controller's port refuses)" : "a security error";
+    return 1;
+  }
+  if (op != NETSNMP_CALLBACK_OP_RECEIVED_MESSAGE && op != NETSNMP_CALLBACK_OP_TIMED_OUT) return 1;
   SnmpReply r;
   if (op == NETSNMP_CALLBACK_OP_RECEIVED_MESSAGE && resp != nullptr) {
     r = reply_of(resp);
-  } else if (op == NETSNMP_CALLBACK_OP_TIMED_OUT) {
-    r.outcome = SnmpReply::Outcome::timeout;
-    r.message = "no answer";
   } else {
-    r.outcome = SnmpReply::Outcome::failure;
-    r.message = "send failed or connection lost";
+    r.outcome = SnmpReply::Outcome::timeout;
+    r.message = pending->note.empty() ? "no answer" : "no answer: " + pending->note;
   }
   if (pending->done) pending->done(r);
   delete pending;
@@ -216,7 +221,7 @@ void SnmpManager::get(SessionId session, std::vector<Oid> oids, Callback done) {
       std::vector<::oid> ids(o.begin(), o.end());
       snmp_add_null_var(pdu, ids.data(), ids.size());
     }
-    auto* pending = new Pending{std::move(done)};
+    auto* pending = new Pending{std::move(done), {}};
     if (snmp_sess_async_send(s->handle, pdu, on_reply, pending) == 0) {
       snmp_free_pdu(pdu);
       pending->done({SnmpReply::Outcome::failure, 0, 0, snmp_api_errstring(snmp_sess_session(s->handle)->s_snmp_errno), {}});
@@ -238,7 +243,7 @@ void SnmpManager::set(SessionId session, std::vector<std::pair<Oid, std::int64_t
       const long value = static_cast<long>(v);
       snmp_pdu_add_variable(pdu, ids.data(), ids.size(), ASN_INTEGER, &value, sizeof value);
     }
-    auto* pending = new Pending{std::move(done)};
+    auto* pending = new Pending{std::move(done), {}};
     if (snmp_sess_async_send(s->handle, pdu, on_reply, pending) == 0) {
       snmp_free_pdu(pdu);
       pending->done({SnmpReply::Outcome::failure, 0, 0, snmp_api_errstring(snmp_sess_session(s->handle)->s_snmp_errno), {}});
@@ -261,7 +266,9 @@ void SnmpManager::run() {
     int timeout_ms = 1000;
     for (auto& s : sessions_) {
       if (s == nullptr || s->handle == nullptr) continue;
-      fds.push_back({snmp_sess_transport(s->handle)->sock, POLLIN, 0});
+      netsnmp_transport* t = snmp_sess_transport(s->handle);
+      if (t == nullptr || t->sock < 0) continue;
+      fds.push_back({t->sock, POLLIN, 0});
       polled.push_back(s.get());
       // The next retransmission or timeout the library has due.
       int nfds = 0, block = 1;

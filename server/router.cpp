@@ -276,6 +276,9 @@ Router::Router(DispatchService& service, TokenAuth auth, RouterConfig config, Cl
       if (!field->last_error.empty()) f["error"] = field->last_error;
       if (field->preempt != 0) f["preempt"] = field->preempt;
       if (field->preempt_state) f["preempt_state"] = ntcip::to_string(*field->preempt_state);
+      f["answers"] = field->answers;
+      if (field->rtt_p50_ms) f["rtt_p50_ms"] = *field->rtt_p50_ms;
+      if (field->rtt_p99_ms) f["rtt_p99_ms"] = *field->rtt_p99_ms;
       out["field"] = std::move(f);
     }
     return out;

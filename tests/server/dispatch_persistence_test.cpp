@@ -51,7 +51,7 @@ TEST(DispatchService, PersistsAndResumesActiveMissionsAfterRestart) {
     EXPECT_GT(store.count("preemption_events"), 0u);
   }  // the process "dies" here: nothing is flushed beyond what each call committed
   Store store(db.path());
-  EXPECT_EQ(store.schema_version(), 4);
+  EXPECT_EQ(store.schema_version(), 5);
   DispatchService service(grid(), {}, &store, 10.0);
   EXPECT_EQ(service.active_mission_count(), 1u);
   const MissionView resumed = service.mission(kept);
@@ -148,13 +148,13 @@ TEST(Store, MigratesVersion1PositionsToEachVehiclesLatest) {
                          "DROP TABLE vehicle_last_position; CREATE INDEX positions_vehicle ON positions(vehicle_id, id);"
                          "ALTER TABLE positions DROP COLUMN disposition; ALTER TABLE positions DROP COLUMN edge;"
                          "ALTER TABLE positions DROP COLUMN offset_m; ALTER TABLE positions DROP COLUMN match_confidence;"
-                         "ALTER TABLE missions DROP COLUMN profile;"
+                         "ALTER TABLE missions DROP COLUMN profile; DROP TABLE signal_calls;"
                          "DELETE FROM schema_migrations WHERE version >= 2;",
                          nullptr, nullptr, nullptr),
             SQLITE_OK);
   sqlite3_close(raw);
   Store store(db.path());
-  EXPECT_EQ(store.schema_version(), 4);
+  EXPECT_EQ(store.schema_version(), 5);
   const auto a = store.last_position("amb-a");
   ASSERT_TRUE(a.has_value());
   EXPECT_DOUBLE_EQ(a->position.lat_deg, 43.732);
@@ -213,7 +213,7 @@ TEST(Store, RefusesADatabaseFromANewerBuild) {
   { Store store(db.path()); }
   {
     Store store(db.path());  // reopening an up-to-date database is fine
-    EXPECT_EQ(store.schema_version(), 4);
+    EXPECT_EQ(store.schema_version(), 5);
   }
   sqlite3* raw = nullptr;
   ASSERT_EQ(sqlite3_open(db.path().c_str(), &raw), SQLITE_OK);

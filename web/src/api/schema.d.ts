@@ -565,6 +565,79 @@ export interface paths {
         patch?: never;
         trace?: never;
     };
+    "/v1/missions/{id}/calls": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** Call records of a mission's signals on field controllers (?limit=N, ?format=csv) */
+        get: {
+            parameters: {
+                query?: never;
+                header?: never;
+                path: {
+                    id: string;
+                };
+                cookie?: never;
+            };
+            requestBody?: never;
+            responses: {
+                /** @description OK */
+                200: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Malformed request */
+                400: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content: {
+                        "application/json": components["schemas"]["Error"];
+                    };
+                };
+                /** @description Missing or invalid token */
+                401: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Token lacks the role */
+                403: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Unknown id */
+                404: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Valid JSON that cannot be applied (off the map, unreachable) */
+                422: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+            };
+        };
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
     "/v1/missions/{id}/cancel": {
         parameters: {
             query?: never;
@@ -861,6 +934,79 @@ export interface paths {
             cookie?: never;
         };
         /** One signalized intersection */
+        get: {
+            parameters: {
+                query?: never;
+                header?: never;
+                path: {
+                    id: string;
+                };
+                cookie?: never;
+            };
+            requestBody?: never;
+            responses: {
+                /** @description OK */
+                200: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Malformed request */
+                400: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content: {
+                        "application/json": components["schemas"]["Error"];
+                    };
+                };
+                /** @description Missing or invalid token */
+                401: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Token lacks the role */
+                403: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Unknown id */
+                404: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+                /** @description Valid JSON that cannot be applied (off the map, unreachable) */
+                422: {
+                    headers: {
+                        [name: string]: unknown;
+                    };
+                    content?: never;
+                };
+            };
+        };
+        put?: never;
+        post?: never;
+        delete?: never;
+        options?: never;
+        head?: never;
+        patch?: never;
+        trace?: never;
+    };
+    "/v1/signals/{id}/calls": {
+        parameters: {
+            query?: never;
+            header?: never;
+            path?: never;
+            cookie?: never;
+        };
+        /** Call records of a field-controlled signal, newest first (?limit=N, ?format=csv): request, grant, release, clear, outcome */
         get: {
             parameters: {
                 query?: never;
@@ -1507,6 +1653,24 @@ export interface components {
             state: string;
         };
         Signal: {
+            /** @description On a signal driven over NTCIP 1202 (serve --controllers): its controller's link and its own report */
+            field?: {
+                answers: number;
+                /** @description Corridor wants a call (preempt or phase control) on it now */
+                call_on: boolean;
+                controller: string;
+                error?: string;
+                last_answer_s?: number;
+                /** @description lights are the controller's own report (its phases are wired), not the in-memory program */
+                lights_reported: boolean;
+                /** @enum {string} */
+                link: "up" | "degraded" | "unreachable";
+                preempt?: number;
+                /** @enum {string} */
+                preempt_state?: "other" | "notActive" | "notActiveWithCall" | "entryStarted" | "trackService" | "dwell" | "linkActive" | "exitStarted" | "maxPresence";
+                rtt_p50_ms?: number;
+                rtt_p99_ms?: number;
+            };
             id: number;
             lights: {
                 /** @enum {string} */
@@ -1524,6 +1688,33 @@ export interface components {
             state: "normal" | "scheduled" | "held" | "recovering";
             /** @description On a SUMO network: the traffic light's id (one signal over all its stop lines) */
             tls_id?: string;
+        };
+        /** @description One call on a field controller, as field systems keep it */
+        SignalCall: {
+            /** @enum {string} */
+            approach: "N" | "E" | "S" | "W";
+            /** @description the controller reports the call off and its preempt out of service */
+            clear_s?: number;
+            controller: string;
+            /** @description first preemptState in service (entry, track, dwell, link) */
+            grant_s?: number;
+            /** Format: int64 */
+            id: number;
+            /** @enum {string} */
+            kind: "preempt" | "phase_control";
+            mission_id?: number;
+            missions: number[];
+            /** @enum {string} */
+            outcome: "pending" | "served" | "denied" | "timed_out" | "unreachable" | "orphan_cleared";
+            preempt?: number;
+            priority: number;
+            release_s?: number;
+            request_s: number;
+            signal: number;
+            vehicle_id: string;
+        };
+        SignalCalls: {
+            calls: components["schemas"]["SignalCall"][];
         };
         /** @description One turn-by-turn instruction, OSRM style. */
         Step: {
