@@ -1,9 +1,21 @@
 #include "server/auth.hpp"
 
+#include "maps/text_id.hpp"
+
 namespace corridor::server {
 
 void TokenAuth::add(const std::string& token, Principal principal) {
   if (token.size() < 16) throw AuthConfigError("token for '" + principal.name + "' is shorter than 16 characters");
+  // A token travels in an Authorization header: printable, no space.
+  if (const auto problem = maps::id_problem(token, 256); problem || token.find(' ') != std::string::npos) {
+    throw AuthConfigError("token for '" + principal.name + "': " + (problem ? "the token " + *problem : std::string("the token has a space")));
+  }
+  if (const auto problem = maps::id_problem(principal.name)) throw AuthConfigError("token name '" + principal.name + "': " + *problem);
+  if (principal.vehicle_id) {
+    if (const auto problem = maps::id_problem(*principal.vehicle_id)) {
+      throw AuthConfigError("token '" + principal.name + "': vehicle_id " + *problem);
+    }
+  }
   if (principal.roles == 0 || (principal.roles & ~kAllRoles) != 0) {
     throw AuthConfigError("token for '" + principal.name + "' needs at least one known role");
   }
@@ -25,6 +37,7 @@ void TokenAuth::add_from_config(const nlohmann::json& config) {
       throw AuthConfigError("config: every token needs a string 'token'");
     }
     Principal p;
+    if (t.contains("name") && !t["name"].is_string()) throw AuthConfigError("config: a token's 'name' must be a string");
     p.name = t.value("name", std::string("unnamed"));
     if (!t.contains("roles") || !t["roles"].is_array()) throw AuthConfigError("config: token '" + p.name + "' needs 'roles'");
     for (const auto& r : t["roles"]) {

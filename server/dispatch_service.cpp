@@ -9,6 +9,7 @@
 
 #include "maps/errors.hpp"
 #include "maps/intersection_geometry.hpp"
+#include "maps/text_id.hpp"
 #include "planner/route_geojson.hpp"
 #include "planner/snap_points.hpp"
 #include "preemption/signal_costs.hpp"
@@ -358,7 +359,7 @@ bool DispatchService::plan_mission(Mission& m, maps::LatLon start, maps::SnapRes
 }
 
 MissionView DispatchService::create_mission(const MissionRequest& req, double now_s) {
-  if (req.vehicle_id.empty() || req.vehicle_id.size() > 64) throw bad_request("vehicle_id must be 1 to 64 characters");
+  if (const auto problem = maps::id_problem(req.vehicle_id)) throw bad_request("vehicle_id: the id " + *problem);
   if (!(req.vmax_kmh >= 5.0 && req.vmax_kmh <= 250.0)) throw bad_request("vmax_kmh must be between 5 and 250");
   if (req.priority < 0 || req.priority > 10) throw bad_request("priority must be between 0 and 10");
   std::lock_guard creating(create_mutex_);
@@ -512,7 +513,7 @@ MissionView DispatchService::cancel_mission(MissionId id, double now_s) {
 }
 
 PositionResult DispatchService::report_position(const PositionReport& p, double now_s) {
-  if (p.vehicle_id.empty() || p.vehicle_id.size() > 64) throw bad_request("vehicle id must be 1 to 64 characters");
+  if (const auto problem = maps::id_problem(p.vehicle_id)) throw bad_request("vehicle id: the id " + *problem);
   if (p.source != "gps" && p.source != "vo") throw bad_request("source must be \"gps\" or \"vo\"");
   if (p.heading_deg && !(std::isfinite(*p.heading_deg) && *p.heading_deg >= 0.0 && *p.heading_deg <= 360.0)) {
     throw bad_request("heading_deg must be within [0, 360]");

@@ -119,6 +119,29 @@ TEST(Router, PathParametersArePercentDecoded) {
   EXPECT_EQ(rig.call("GET", "/v1/missions?state=%61ctive", kViewer).status, 200);  // "active"
 }
 
+// Ids are printable ASCII, 1 to 64 characters: a NUL, a CR/LF (a header smuggled into a log or a
+// reply), a byte outside ASCII or an overlong id is a 400 that says which character; nothing is
+// stored.
+TEST(Router, IdsOutsidePrintableAsciiAreRefusedNamingTheCharacter) {
+  Rig rig;
+  const auto at = grid().projection().to_lat_lon(grid().position(NodeId{0}));
+  const std::string pos = R"({"lat":)" + std::to_string(at.lat_deg) + R"(,"lon":)" + std::to_string(at.lon_deg) + R"(,"timestamp":1})";
+  const std::vector<std::pair<std::string, std::string>> bad{{"a%00b", "character 2 is 0x00"},
+                                                             {"a%0d%0aX-Injected:%201", "character 2 is 0x0d"},
+                                                             {"caf%C3%A9", "character 4 is 0xc3"},
+                                                             {std::string(65, 'x'), "65 characters long"},
+                                                             {"%20lead", "begins or ends with a space"}};
+  for (const auto& [id, says] : bad) {
+    const auto r = rig.call("POST", "/v1/vehicles/" + id + "/position", kDispatcher, pos);
+    EXPECT_EQ(r.status, 400) << id;
+    EXPECT_NE(body(r)["error"]["message"].get<std::string>().find(says), std::string::npos) << id << ": " << r.body;
+  }
+  const auto created = rig.call("POST", "/v1/missions", kDispatcher, mission_body("amb\\u0000x"));
+  EXPECT_EQ(created.status, 400) << created.body;
+  EXPECT_NE(created.body.find("0x00"), std::string::npos) << created.body;
+  EXPECT_TRUE(body(rig.call("GET", "/v1/vehicles", kViewer))["vehicles"].empty());
+}
+
 // A vehicle token without a vehicle id could report for any vehicle: refused when the config is
 // read, not at the first report.
 TEST(Router, AVehicleTokenMustNameItsVehicle) {
@@ -312,7 +335,7 @@ TEST(Router, OpenApiMatchesTheImplementation) {
       EXPECT_TRUE(op.contains("responses")) << path;
     }
   }
-  EXPECT_EQ(operations, 18u);
+  EXPECT_EQ(operations, 20u);
 }
 
 // Random and mutated requests: the router answers every one with a status below 500.
