@@ -69,7 +69,12 @@ json matched_route(const maps::RoadGraph& g, const std::vector<localizer::Matche
 
 void run_match(const MatchOptions& o) {
   const maps::RoadGraph graph = load_map_from_options(o.map);
-  const std::vector<localizer::GpsFix> trace = localizer::read_trace(o.trace);
+  localizer::TraceTiming timing = localizer::TraceTiming::measured;
+  const std::vector<localizer::GpsFix> trace = localizer::read_trace(o.trace, &timing);
+  const bool timed = timing == localizer::TraceTiming::measured;
+  if (!timed) {
+    std::cerr << "corridor match: the trace has no timing (no <time>, or one time for every point): matched by its geometry alone\n";
+  }
   const maps::EdgeSnapper snapper(graph);
   localizer::HmmMatcher matcher(graph, snapper);
   const auto started = std::chrono::steady_clock::now();
@@ -81,7 +86,7 @@ void run_match(const MatchOptions& o) {
   std::size_t matched_count = 0;
   for (std::size_t i = 0; i < matched.size(); ++i) {
     const auto& m = matched[i];
-    json p{{"time_s", trace[i].time_s}, {"matched", m.matched}, {"outlier", m.outlier}};
+    json p{{"time_s", timed ? json(trace[i].time_s) : json(nullptr)}, {"matched", m.matched}, {"outlier", m.outlier}};
     if (m.matched) {
       ++matched_count;
       const maps::LatLon at = graph.projection().to_lat_lon(m.point);
@@ -114,7 +119,10 @@ void run_match(const MatchOptions& o) {
   if (!o.out.empty()) {
     std::ofstream out(o.out);
     if (!out) throw UsageError("cannot write --out '" + o.out + "'");
-    out << json{{"type", "Feature"}, {"geometry", route}, {"properties", {{"fixes", trace.size()}, {"matched", matched_count}}}}.dump()
+    out << json{{"type", "Feature"},
+                {"geometry", route},
+                {"properties", {{"fixes", trace.size()}, {"matched", matched_count}, {"timing", timed ? "measured" : "none"}}}}
+               .dump()
         << '\n';
   }
   if (o.json) {
@@ -123,12 +131,14 @@ void run_match(const MatchOptions& o) {
                       {"route", route},
                       {"fixes", trace.size()},
                       {"matched", matched_count},
+                      {"timing", timed ? "measured" : "none"},
                       {"points_per_s", per_s}}
                      .dump()
               << '\n';
     return;
   }
-  std::cout << matched_count << " of " << trace.size() << " fixes matched (" << static_cast<long>(per_s) << " fixes/s)\n";
+  std::cout << matched_count << " of " << trace.size() << " fixes matched (" << static_cast<long>(per_s) << " fixes/s)"
+            << (timed ? "" : ", by geometry alone: the trace has no timing") << "\n";
   std::cout << "streets:";
   for (const auto& n : way_names) std::cout << " " << n.get<std::string>() << " →";
   std::cout << (way_names.empty() ? " (unnamed)\n" : " end\n");

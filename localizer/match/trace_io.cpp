@@ -47,6 +47,8 @@ struct GpxParser {
   std::vector<GpsFix> fixes;
   std::optional<GpsFix> current;
   bool current_has_time = false;
+  std::size_t timed = 0, untimed = 0;
+  std::size_t first_untimed = 0, first_timed = 0;  // their point numbers, for the message
   std::string text;
   std::string error;
   std::size_t points = 0;
@@ -95,11 +97,12 @@ struct GpxParser {
       } else if (n == "speed") {
         current->speed_mps = to_number(value);
       } else if (n == "trkpt" || n == "rtept" || n == "wpt") {
-        if (!current_has_time) {
-          fail("GPX point " + std::to_string(points) + " has no <time>: map matching needs when each fix was taken");
-        } else {
-          fixes.push_back(*current);
+        if (current_has_time) {
+          if (timed++ == 0) first_timed = points;
+        } else if (untimed++ == 0) {
+          first_untimed = points;
         }
+        fixes.push_back(*current);
         current.reset();
       }
     }
@@ -143,7 +146,7 @@ double parse_iso8601(const std::string& s) {
   return seconds;
 }
 
-std::vector<GpsFix> parse_gpx(const std::string& text) {
+std::vector<GpsFix> parse_gpx(const std::string& text, TraceTiming* timing) {
   std::unique_ptr<XML_ParserStruct, decltype(&XML_ParserFree)> parser(XML_ParserCreate(nullptr), &XML_ParserFree);
   if (!parser) throw TraceError("cannot create an XML parser");
   GpxParser gpx;
@@ -160,6 +163,36 @@ std::vector<GpsFix> parse_gpx(const std::string& text) {
                      " at line " + std::to_string(XML_GetCurrentLineNumber(parser.get())));
   }
   if (!gpx.error.empty()) throw TraceError(gpx.error);
+  if (gpx.timed > 0 && gpx.untimed > 0) {
+    throw TraceError("GPX point " + std::to_string(gpx.first_untimed) + " has no <time>, but point " + std::to_string(gpx.first_timed) +
+                     " has one: a trace is timed throughout or not at all");
+  }
+  // No time at all, or one time for every point (an export that stamped the file, not the fixes).
+  const bool all_same = gpx.fixes.size() > 1 && std::all_of(gpx.fixes.begin(), gpx.fixes.end(), [&](const GpsFix& f) {
+                          return f.time_s == gpx.fixes.front().time_s;
+                        });
+  if (gpx.untimed > 0 || all_same) {
+    if (gpx.fixes.empty()) throw TraceError("the trace has no GPX points");
+    if (timing == nullptr) {
+      throw TraceError(gpx.untimed > 0 ? "GPX point " + std::to_string(gpx.first_untimed) + " has no <time>: this needs when each fix was taken"
+                                       : std::string("every GPX point has the same <time>: this needs when each fix was taken"));
+    }
+    *timing = TraceTiming::none;
+    // Timed by distance at a nominal pace, from the first point's time (0 where it had none).
+    const double start = gpx.untimed > 0 ? 0.0 : gpx.fixes.front().time_s;
+    const maps::LocalProjection frame(gpx.fixes.front().position);
+    double t = start;
+    for (std::size_t i = 0; i < gpx.fixes.size(); ++i) {
+      if (i > 0) {
+        const double step_m = maps::distance_m(frame.to_local(gpx.fixes[i - 1].position), frame.to_local(gpx.fixes[i].position));
+        t += std::max(1.0, step_m / kUntimedPaceMps);
+      }
+      gpx.fixes[i].time_s = t;
+      gpx.fixes[i].speed_mps.reset();  // a speed without times is not one this trace measured
+    }
+    return gpx.fixes;
+  }
+  if (timing != nullptr) *timing = TraceTiming::measured;
   check_order(gpx.fixes, "GPX points");
   return gpx.fixes;
 }
@@ -219,7 +252,7 @@ std::vector<GpsFix> parse_csv(const std::string& text) {
   return fixes;
 }
 
-std::vector<GpsFix> read_trace(const std::filesystem::path& file) {
+std::vector<GpsFix> read_trace(const std::filesystem::path& file, TraceTiming* timing) {
   std::ifstream in(file, std::ios::binary);
   if (!in) throw TraceError("trace file not found: '" + file.string() + "'");
   std::ostringstream all;
@@ -227,7 +260,9 @@ std::vector<GpsFix> read_trace(const std::filesystem::path& file) {
   const std::string text = all.str();
   const std::string head = trim(text.substr(0, 256));
   if (head.empty()) throw TraceError("trace file '" + file.string() + "' is empty");
-  return head[0] == '<' ? parse_gpx(text) : parse_csv(text);
+  if (head[0] == '<') return parse_gpx(text, timing);
+  if (timing != nullptr) *timing = TraceTiming::measured;
+  return parse_csv(text);
 }
 
 }  // namespace corridor::localizer

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # `corridor match` as a user runs it: a GPX and a CSV trace on the embedded map give the JSON
-# contract (points, way_names, route, points_per_s); a multipath fix is flagged as an outlier; bad
-# traces give a clear error and exit 1.
+# contract (points, way_names, route, points_per_s); a GPX without times, or with one time for all
+# its points, is matched by its geometry and says it had no timing; a multipath fix is flagged as
+# an outlier; bad traces give a clear error and exit 1.
 # Usage: match_cli_test.sh CORRIDOR_BINARY
 set -uo pipefail
 corridor=$1
@@ -36,6 +37,12 @@ with open(f"{work}/trace.gpx", "w") as f:
     for i, (x, y) in enumerate(pts):
         f.write(f'<trkpt lat="{y}" lon="{x}"><time>2024-05-01T12:{i // 60:02d}:{i % 60:02d}Z</time><hdop>1.2</hdop></trkpt>')
     f.write("</trkseg></trk></gpx>")
+for name, stamp in (("untimed", lambda i: ""), ("same-time", lambda i: "<time>2024-05-01T12:00:00Z</time>")):
+    with open(f"{work}/{name}.gpx", "w") as f:  # common exports: no timing at all
+        f.write('<?xml version="1.0"?><gpx version="1.1" xmlns="http://www.topografix.com/GPX/1/1"><trk><trkseg>')
+        for i, (x, y) in enumerate(pts):
+            f.write(f'<trkpt lat="{y}" lon="{x}">{stamp(i)}</trkpt>')
+        f.write("</trkseg></trk></gpx>")
 PY
 for kind in csv gpx; do
   "$corridor" match --trace "$work/trace.$kind" --json --out "$work/out.$kind.geojson" > "$work/match.$kind.json" 2> "$work/err"
@@ -49,6 +56,21 @@ assert len(d['way_names']) >= 2 and all(a != b for a, b in zip(d['way_names'], d
 \""
   check "$kind: --out is a GeoJSON Feature" "python3 -c \"import json; assert json.load(open('$work/out.$kind.geojson'))['type'] == 'Feature'\""
 done
+
+# Without timing: matched by geometry, and the output says so.
+for kind in untimed same-time; do
+  "$corridor" match --trace "$work/$kind.gpx" --json > "$work/match.$kind.json" 2> "$work/err"
+  check "$kind GPX: exit 0" "[[ $? -eq 0 ]]"
+  check "$kind GPX: says it had no timing" "grep -q 'no timing' '$work/err'"
+  check "$kind GPX: matched by geometry, timing none, no times" "python3 -c \"
+import json; d=json.load(open('$work/match.$kind.json')); p=d['points']
+assert d['timing'] == 'none', d['timing']
+assert sum(x['matched'] for x in p) >= 0.95 * len(p), sum(x['matched'] for x in p)
+assert all(x['time_s'] is None for x in p)
+assert len(d['way_names']) >= 2
+\""
+done
+check "a timed trace says its timing was measured" "python3 -c \"import json; assert json.load(open('$work/match.gpx.json'))['timing'] == 'measured'\""
 
 # A multipath fix is set aside, flagged, and placed on the road where its neighbours put the vehicle.
 "$corridor" match --trace "$work/outlier.csv" --json > "$work/outlier.json" 2> "$work/err"
@@ -71,7 +93,9 @@ expect_error "empty trace" "" "empty"
 expect_error "unsorted times" $'time,lat,lon\n5,43.7384,7.4246\n4,43.7385,7.4247\n' "earlier than the one before"
 expect_error "NaN" $'time,lat,lon\n0,nan,7.4246\n' "not a finite number"
 expect_error "GPX that is not XML" '<gpx><trkpt lat="1" lon="2"><time>x' "not well-formed"
-expect_error "GPX point without a time" '<gpx><trk><trkseg><trkpt lat="43.7384" lon="7.4246"/></trkseg></trk></gpx>' "no <time>"
+expect_error "GPX with some points timed and some not" \
+  '<gpx><trk><trkseg><trkpt lat="43.7384" lon="7.4246"><time>2024-05-01T12:00:00Z</time></trkpt><trkpt lat="43.7385" lon="7.4247"/></trkseg></trk></gpx>' \
+  "timed throughout or not at all"
 expect_error "a trace entirely off the map" $'time,lat,lon\n0,48.85,2.35\n1,48.8501,2.3501\n' "within reach of a road"
 "$corridor" match --trace "$work/nowhere.csv" > /dev/null 2> "$work/err"
 check "missing file: exit 1" "[[ $? -eq 1 ]] && grep -q 'not found' '$work/err'"
