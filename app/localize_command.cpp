@@ -5,20 +5,25 @@
 #include <cmath>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <numbers>
 #include <random>
 #include <sstream>
 #include <thread>
 
 #include <nlohmann/json.hpp>
+#include <spdlog/spdlog.h>
 
 #include "app/cli_error.hpp"
 #include "app/map_options.hpp"
 #include "app/vo_command.hpp"
+#include "gnss/gpsd_source.hpp"
+#include "gnss/nmea_replay.hpp"
 #include "localizer/fusion/gps_odometry_localizer.hpp"
 #include "localizer/fusion/simulated_odometry.hpp"
 #include "localizer/match/trace_io.hpp"
 #include "localizer/study/localization_study.hpp"
+#include "maps/text_id.hpp"
 #include "sim/corridor_client.hpp"
 
 namespace corridor::app {
@@ -29,6 +34,8 @@ using nlohmann::json;
 struct LocalizeOptions {
   MapOptions map;
   std::string gps;
+  std::string gpsd;  // HOST:PORT
+  std::string nmea;
   std::string seq;
   std::string truth;
   bool json = false;
@@ -43,6 +50,7 @@ struct LocalizeOptions {
   std::string vehicle;
   std::string token;
   double speedup = 1.0;
+  double gpsd_idle_s = 10.0;
 };
 
 struct TruthRow {
@@ -98,9 +106,123 @@ std::vector<std::pair<double, double>> parse_outages(const std::vector<std::stri
   return out;
 }
 
+// What became of a receiver's reports: how many, how many became fixes, and why the others did not.
+struct ReceiverTally {
+  std::size_t reports = 0;
+  std::size_t fixes = 0;
+  std::map<std::string, std::size_t> refused;
+  std::size_t duplicates = 0;
+  std::size_t bad_checksums = 0;  // an NMEA log's, found before gpsd
+  std::string ended;              // a live receiver: why its stream ended
+  [[nodiscard]] json to_json() const {
+    json j{{"reports", reports}, {"fixes", fixes}, {"refused", refused}, {"duplicate_epochs", duplicates}};
+    if (bad_checksums > 0) j["bad_checksums"] = bad_checksums;
+    if (!ended.empty()) j["ended"] = ended;
+    return j;
+  }
+};
+
+// Every epoch of a recorded NMEA log, through gpsd, as fixes (those with a 2D/3D fix).
+std::vector<localizer::GpsFix> read_nmea(const std::string& file, ReceiverTally& tally) {
+  gnss::NmeaReplay replay(file);
+  tally.bad_checksums = replay.check().bad_checksums;
+  std::vector<localizer::GpsFix> fixes;
+  while (const auto r = replay.next()) {
+    ++tally.reports;
+    std::string why;
+    if (const auto f = gnss::to_fix(*r, &why)) {
+      if (!fixes.empty() && f->time_s <= fixes.back().time_s) continue;  // an epoch gpsd gave twice
+      fixes.push_back(*f);
+      ++tally.fixes;
+    } else {
+      ++tally.refused[why];
+    }
+  }
+  if (fixes.empty()) throw UsageError("'" + file + "': gpsd found no 2D/3D fix in the log");
+  return fixes;
+}
+
+// A live receiver through gpsd: each fix localized and posted as it comes, until the receiver's
+// stream ends (idle, or its gpsd gone and not back).
+void run_live_gpsd(const LocalizeOptions& o, const maps::RoadGraph& graph, const maps::EdgeSnapper& snapper) {
+  const auto colon = o.gpsd.rfind(':');
+  if (colon == std::string::npos || colon == 0 || colon + 1 == o.gpsd.size()) {
+    throw UsageError("--gpsd expects HOST:PORT (gpsd listens on 2947), got '" + o.gpsd + "'");
+  }
+  gnss::GpsdSourceOptions options;
+  options.idle_timeout_s = o.gpsd_idle_s;
+  std::unique_ptr<gnss::GpsdSource> source;
+  try {
+    source = std::make_unique<gnss::GpsdSource>(o.gpsd.substr(0, colon), o.gpsd.substr(colon + 1), options);
+  } catch (const gnss::GnssError& e) {
+    throw std::runtime_error(e.what());
+  }
+  localizer::GpsOdometryLocalizer fusion(graph, snapper);
+  std::unique_ptr<sim::CorridorClient> client;
+  if (!o.server.empty()) client = std::make_unique<sim::CorridorClient>(o.server, o.token);
+  ReceiverTally tally;
+  json points = json::array();
+  std::size_t posted = 0;
+  double last_time = -1e18;
+  while (const auto r = source->next()) {
+    ++tally.reports;
+    std::string why;
+    const auto fix = gnss::to_fix(*r, &why);
+    if (!fix) {
+      ++tally.refused[why];
+      continue;
+    }
+    if (fix->time_s <= last_time) continue;
+    last_time = fix->time_s;
+    ++tally.fixes;
+    fusion.on_gps(*fix);
+    const localizer::LocalizedPoint& p = fusion.last();
+    if (p.source == localizer::PositionSource::none) continue;
+    json j{{"time_s", fix->time_s}, {"lat", p.position.lat_deg}, {"lon", p.position.lon_deg}, {"heading_deg", p.heading_deg},
+           {"edge", p.match.edge.v}, {"name", graph.name(p.match.edge)}, {"sigma_m", p.sigma_m}, {"source", localizer::to_string(p.source)}};
+    if (client) {
+      // The receiver's own time: a live fix is now.
+      json body{{"lat", p.position.lat_deg}, {"lon", p.position.lon_deg}, {"heading_deg", p.heading_deg}, {"timestamp", fix->time_s},
+                {"source", "gps"}};
+      if (fix->hdop) body["hdop"] = *fix->hdop;
+      if (fix->speed_mps) body["speed_mps"] = *fix->speed_mps;
+      (void)client->post("/v1/vehicles/" + sim::path_segment(o.vehicle) + "/position", body);
+      ++posted;
+    }
+    if (o.json) std::cout << j.dump() << std::endl;  // a stream: one line per position
+    points.push_back(std::move(j));
+  }
+  tally.duplicates = source->duplicates();
+  tally.ended = source->ended();
+  if (tally.ended == "disconnected") spdlog::warn("event=gpsd_lost detail=\"the receiver's gpsd went away and did not come back\"");
+  json summary{{"positions", points.size()}, {"receiver", tally.to_json()}, {"reconnects", source->reconnects()}};
+  if (client) summary["posted_gps"] = posted;
+  if (!o.out.empty()) {
+    std::ofstream out(o.out);
+    if (!out) throw UsageError("cannot write --out '" + o.out + "'");
+    out << points.dump() << '\n';
+  }
+  std::cout << (o.json ? json{{"summary", summary}}.dump() : summary.dump(2)) << '\n';
+}
+
 void run_localize(const LocalizeOptions& o) {
-  if (o.gps.empty() && o.truth.empty()) throw UsageError("give --gps, or --truth to simulate GPS from");
-  if (o.seq.empty() && o.truth.empty()) throw UsageError("give --seq (stereo odometry), or --truth to simulate odometry from");
+  const int sources = (o.gps.empty() ? 0 : 1) + (o.gpsd.empty() ? 0 : 1) + (o.nmea.empty() ? 0 : 1);
+  if (sources > 1) throw UsageError("give one GPS source: --gps, --gpsd or --nmea");
+  if (!(o.gpsd_idle_s > 0.0 && o.gpsd_idle_s <= 3600.0)) throw UsageError("--gpsd-idle-s must be in (0, 3600]");
+  if (!o.server.empty() && (o.vehicle.empty() || o.token.empty())) throw UsageError("--server needs --vehicle and --token");
+  if (!o.vehicle.empty()) {
+    if (const auto problem = maps::id_problem(o.vehicle)) throw UsageError("--vehicle: the id " + *problem);
+  }
+  if (!o.gpsd.empty()) {
+    if (!o.seq.empty() || !o.truth.empty()) throw UsageError("--gpsd is a live receiver: it takes no --seq or --truth");
+    const maps::RoadGraph graph = load_map_from_options(o.map);
+    const maps::EdgeSnapper snapper(graph);
+    run_live_gpsd(o, graph, snapper);
+    return;
+  }
+  if (sources == 0 && o.truth.empty()) throw UsageError("give --gps, --gpsd or --nmea, or --truth to simulate GPS from");
+  const bool gps_only = o.seq.empty() && o.truth.empty();
+  if (gps_only && o.nmea.empty()) throw UsageError("give --seq (stereo odometry), or --truth to simulate odometry from");
   if (!(o.gps_rate_hz > 0.0 && o.gps_rate_hz <= 50.0) || !(o.gps_noise_m >= 0.0) || !(o.speedup > 0.0)) {
     throw UsageError("--gps-rate-hz must be in (0, 50], --gps-noise-m >= 0 and --speedup > 0");
   }
@@ -112,8 +234,15 @@ void run_localize(const LocalizeOptions& o) {
 
   // GPS: from the file, or from the truth with noise, dropped inside the outages.
   std::vector<localizer::GpsFix> gps;
+  ReceiverTally tally;
   if (!o.gps.empty()) {
     gps = localizer::read_trace(o.gps);
+  } else if (!o.nmea.empty()) {
+    try {
+      gps = read_nmea(o.nmea, tally);
+    } catch (const gnss::GnssError& e) {
+      throw UsageError(e.what());
+    }
   } else {
     std::mt19937_64 rng(o.seed);
     std::normal_distribution<double> noise(0.0, o.gps_noise_m), unit(0.0, 1.0);
@@ -228,6 +357,7 @@ void run_localize(const LocalizeOptions& o) {
   }
   if (points.empty()) throw UsageError("nothing could be localized: no GPS fix matched the map");
   json summary{{"positions", points.size()}, {"gps_fixes", gps.size()}, {"odometry_steps", odometry.size()}};
+  if (!o.nmea.empty()) summary["receiver"] = tally.to_json();
   if (!truth.empty()) {
     summary["rmse_m"] = std::sqrt(sq / static_cast<double>(std::max<std::size_t>(1, scored)));
     summary["correct_edge_share"] = scored > 0 ? static_cast<double>(on_edge) / static_cast<double>(scored) : 0.0;
@@ -259,6 +389,12 @@ void register_localize_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("localize", "Fuse GPS and stereo odometry on a map; optionally feed a live server");
   add_map_options(*cmd, o->map);
   cmd->add_option("--gps", o->gps, "GPS trace (GPX or CSV time,lat,lon[,hdop,heading_deg,speed_mps]); else simulated from --truth");
+  cmd->add_option("--gpsd", o->gpsd,
+                  "a live receiver: gpsd at HOST:PORT (its reports through libgps; fixes without a 2D/3D mode are refused); "
+                  "each position is printed (--json: a line each) and posted (--server) as it comes");
+  cmd->add_option("--nmea", o->nmea, "a recorded NMEA 0183 log, decoded by a private gpsd as a receiver's would be");
+  cmd->add_option("--gpsd-idle-s", o->gpsd_idle_s, "with --gpsd: no report for this long ends the run (receiver gone)")
+      ->capture_default_str();
   cmd->add_option("--seq", o->seq, "KITTI-layout stereo sequence for the odometry; else simulated from --truth");
   cmd->add_option("--truth", o->truth, "drive.csv from corridor vo synth: scores the output and feeds the simulations");
   cmd->add_flag("--json", o->json, "print the summary and every position as JSON");
