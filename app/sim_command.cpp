@@ -11,6 +11,7 @@
 #include <memory>
 
 #include "app/cli_error.hpp"
+#include "app/listen_address.hpp"
 #include "maps/sumo_vehicle_class.hpp"
 #include "sim/closed_loop.hpp"
 #include "sim/run_record.hpp"
@@ -52,6 +53,10 @@ struct SimOptions {
   bool time_space = false;
   std::string ev_vclass = "emergency";
   bool rebuild_net = false;
+  bool ntcip = false;
+  std::string ntcip_listen = "127.0.0.1:16100";
+  std::string read_community = "public";
+  std::string write_community = "private";
 };
 
 sim::EvRouting parse_routing(const std::string& s) {
@@ -137,6 +142,15 @@ void run_sim(const SimOptions& o) {
     c.gps_outages.emplace_back(start, start + duration);
   }
   c.server_token = o.token;
+  if (o.ntcip) {
+    if (o.server.empty()) throw UsageError("--ntcip puts the lights behind NTCIP agents that a server drives: give --server");
+    const ListenAddress at = parse_listen_address(o.ntcip_listen, "--ntcip-listen", 1);
+    c.ntcip = true;
+    c.ntcip_host = at.host;
+    c.ntcip_port = static_cast<unsigned short>(at.port);
+    c.read_community = o.read_community;
+    c.write_community = o.write_community;
+  }
   if (!o.server.empty() && o.token.empty()) {
     const char* env = std::getenv("CORRIDOR_TOKEN");
     if (env == nullptr || *env == '\0') throw UsageError("--server needs --token (or $CORRIDOR_TOKEN) with the dispatcher and vehicle roles");
@@ -239,6 +253,13 @@ void register_sim_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--rebuild-net", o->rebuild_net,
                 "a net written by a newer netconvert is converted with the installed one into the work directory");
+  cmd->add_flag("--ntcip", o->ntcip,
+                "with --server: SUMO's lights behind virtual NTCIP 1202 controllers that the server drives over SNMP "
+                "(serve --controllers with signal-agent --manifest-only's manifest for this net and --ntcip-listen)");
+  cmd->add_option("--ntcip-listen", o->ntcip_listen, "with --ntcip: HOST:PORT of the first controller, the others on the next ports")
+      ->capture_default_str();
+  cmd->add_option("--read-community", o->read_community, "with --ntcip: the agents' read community")->capture_default_str();
+  cmd->add_option("--write-community", o->write_community, "with --ntcip: the agents' write community")->capture_default_str();
   cmd->add_flag("--time-space", o->time_space,
                 "write the EVs' trajectories and lights (RUN.ev_trajectory.csv, RUN.ev_signals.csv, RUN.time_space.svg)");
   cmd->callback([o] { run_sim(*o); });

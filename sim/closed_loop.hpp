@@ -47,6 +47,14 @@ struct ClosedLoopConfig {
   // same SUMO net (--map FILE.net.xml); SUMO then keeps wall-clock pace.
   std::string server_url;
   std::string server_token;
+  // With a server: the lights are NTCIP 1202 controllers, virtual agents over SUMO's own lights on
+  // consecutive UDP ports from ntcip_port, which the server drives (serve --controllers with their
+  // manifest), instead of the server's signal states mirrored onto SUMO: SUMO <- agent <- SNMP <- server.
+  bool ntcip = false;
+  std::string ntcip_host = "127.0.0.1";
+  unsigned short ntcip_port = 16100;
+  std::string read_community = "public";
+  std::string write_community = "private";
   EvRouting routing = EvRouting::dynamic_route;
   EvSignals signals = EvSignals::corridor;
   std::string ev_from;  // SUMO edge ids

@@ -5,12 +5,15 @@
 #include <libsumo/libtraci.h>
 
 #include <chrono>
+#include <cmath>
+#include <optional>
 #include <map>
 #include <thread>
 
 #include <random>
 
 #include "localizer/fusion/gps_odometry_localizer.hpp"
+#include "ntcip/virtual_agents.hpp"
 #include "localizer/fusion/simulated_odometry.hpp"
 #include "sim/closed_loop_run.hpp"
 #include "sim/corridor_client.hpp"
@@ -40,6 +43,20 @@ json position_json(const maps::RoadGraph& g, maps::Point2 p, double heading_deg,
 
 double wall_s() { return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count(); }
 
+struct TraciLightsApi {
+  using TrafficLight = libtraci::TrafficLight;
+};
+
+// The scenario's lights as a SignalMap, keyed as the server keys a SUMO net's (maps::sumo_signal_map).
+maps::SignalMap signal_map_of(const SumoScenario& s) {
+  maps::SignalMap m;
+  m.plans = s.plans;
+  m.signals = s.signal_plans;
+  m.signal_of = s.signal_node;
+  for (const auto& [key, plan] : s.signal_plans) m.names.emplace(key, s.sumo_plan_of.at(key)->tls_id);
+  return m;
+}
+
 }  // namespace
 
 ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const ClosedLoopConfig& config) {
@@ -64,6 +81,26 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
 
   const SumoLaunch launch = launch_for(scenario, config);
   SumoBridge bridge(launch);
+
+  // NTCIP: SUMO's lights behind virtual controllers the server drives over SNMP. The agents run on
+  // this thread, between steps and while the loop waits for the wall clock, in simulation time.
+  detail::ApiTrafficLights<TraciLightsApi> lights_api;
+  std::optional<SumoSignalController> field_lights;
+  std::optional<maps::SignalMap> signal_map;
+  std::optional<ntcip::VirtualAgents> agents;
+  if (config.ntcip) {
+    field_lights.emplace(scenario.signal_plans, scenario.sumo_plan_of, scenario.tls_phases, lights_api, scenario.actuated_tls);
+    signal_map.emplace(signal_map_of(scenario));
+    ntcip::VirtualAgentsConfig agents_config;
+    agents_config.host = config.ntcip_host;
+    agents_config.first_port = config.ntcip_port;
+    agents_config.security.read_community = config.read_community;
+    agents_config.security.write_community = config.write_community;
+    agents_config.security.state_dir = config.out_dir / (config.run_name + ".snmp");
+    agents_config.security.engine_name = "corridor-" + std::to_string(config.ntcip_port);
+    agents.emplace(g, *signal_map, *field_lights, agents_config, bridge.time_s());
+    spdlog::info("event=ntcip_agents count={} first_port={}", agents->manifest().size(), config.ntcip_port);
+  }
 
   libtraci::Simulation::subscribe(std::vector<int>{libsumo::VAR_COLLIDING_VEHICLES_NUMBER, libsumo::VAR_TELEPORT_STARTING_VEHICLES_NUMBER});
   for (const auto& [id, arcs] : sg.arcs_onto) libtraci::Edge::subscribe(id, {libsumo::VAR_CURRENT_TRAVELTIME});
@@ -106,8 +143,18 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
   for (int step = 0; t < config.end_s; ++step) {
     // SUMO keeps pace with the wall clock, which the server's schedule runs on.
     const double due = wall_start + (t - begin_s);
-    if (const double wait = due - wall_s(); wait > 0) std::this_thread::sleep_for(std::chrono::duration<double>(wait));
+    if (agents) {
+      // The controllers keep answering while the loop waits for the wall clock.
+      for (double wait = due - wall_s(); wait > 0; wait = due - wall_s()) agents->poll(static_cast<int>(std::ceil(wait * 1000.0)), t);
+    } else if (const double wait = due - wall_s(); wait > 0) {
+      std::this_thread::sleep_for(std::chrono::duration<double>(wait));
+    }
     t = bridge.step();
+    lights_api.now_s = t;
+    if (agents) {
+      field_lights->update(t);
+      agents->poll(0, t);
+    }
     // The same clock as `due`: a scenario that begins at 07:00 is not seven hours ahead of the
     // server's, which refuses positions from further ahead than its clock skew allows.
     const double now = wall_start + (t - begin_s);
@@ -254,8 +301,9 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
     }
 
     // Mirror the server's signals: held and clearing lights are shown as the server shows them;
-    // back on its program, the light gets SUMO's program again at the server's step.
-    const json signals = server.get("/v1/signals");
+    // back on its program, the light gets SUMO's program again at the server's step. Through
+    // NTCIP the agents drive the lights instead.
+    const json signals = agents ? json{{"signals", json::array()}} : server.get("/v1/signals");
     for (const auto& s : signals.at("signals")) {
       const auto node = s.at("id").get<std::uint32_t>();
       const std::string mode = s.at("mode");
@@ -289,8 +337,9 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
         ++restored;
       }
     }
-    if (ev_done && taken_over.empty() && step % 10 == 0 && libtraci::Simulation::getMinExpectedNumber() == 0) break;
-    if (ev_done && taken_over.empty() && t > ev_depart + result.ev_travel_time_s + 10.0) break;
+    const bool lights_home = !field_lights || field_lights->lights_on_program() == field_lights->lights_taken_over();
+    if (ev_done && taken_over.empty() && lights_home && step % 10 == 0 && libtraci::Simulation::getMinExpectedNumber() == 0) break;
+    if (ev_done && taken_over.empty() && lights_home && t > ev_depart + result.ev_travel_time_s + 10.0) break;
   }
   result.end_time_s = t;
   result.preempted_signals = preempted.size();
@@ -298,6 +347,15 @@ ClosedLoopResult run_closed_loop_server(const SumoScenario& scenario, const Clos
   result.preemptions_released = restored;
   result.lights_taken_over = restored + taken_over.size();
   result.lights_back_on_program = restored;
+  if (field_lights) {
+    // What the agents' lights did: every hold they reached, and their audit.
+    result.lights_taken_over = field_lights->lights_taken_over();
+    result.lights_back_on_program = field_lights->lights_on_program();
+    result.preemptions_started = field_lights->holds_reached();
+    result.preemptions_released = field_lights->programs_restored();
+    result.safety_violations = field_lights->violations();
+    result.preempted_signals = field_lights->lights_taken_over();
+  }
   bridge.close();
   add_trip_results(launch.tripinfo, {kEv}, result);
   return result;
