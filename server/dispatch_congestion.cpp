@@ -265,6 +265,7 @@ void DispatchService::tick(double now_s) {
     drain_call_records(staged);
     // Recovery ends inside the signals' own clock, without an engine event.
     for (const auto& [node, plan] : signals_map_.signals) announce_signal_state(node, now_s);
+    announce_field_states(now_s);
   }
   submit(staged);
 }

@@ -203,6 +203,9 @@ class DispatchService {
   void emit(DispatchEvent event);
   // Under preemption_mutex_: emits signal_state when the signal's state changed since last said.
   void announce_signal_state(NodeId node, double now_s);
+  // Under preemption_mutex_: a signal_field event for each field controller whose link, preempt
+  // state or call changed since the last one (the console's live view of the controllers).
+  void announce_field_states(double now_s);
   [[nodiscard]] std::string signal_state_locked(NodeId node) const;
   MissionView view(const Mission& m) const;
   static planner::VehicleProfile vehicle_profile(const MissionRow& row);
@@ -258,6 +261,7 @@ class DispatchService {
   preemption::PreemptionEngine preemption_;
   std::deque<SignalCallRow> recent_calls_;  // without a store: the latest call records
   std::unordered_map<NodeId, std::string> shown_signal_state_;  // last announced signal_state
+  std::unordered_map<NodeId, std::string> shown_field_state_;   // last announced signal_field
 
   mutable std::shared_mutex registry_mutex_;
   std::map<MissionId, MissionPtr> missions_;

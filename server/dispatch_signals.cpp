@@ -61,6 +61,25 @@ void DispatchService::announce_signal_state(NodeId node, double now_s) {
   emit(std::move(e));
 }
 
+void DispatchService::announce_field_states(double now_s) {
+  if (!field_) return;
+  for (const ntcip::FieldStatus& f : field_->status()) {
+    DispatchEvent e;
+    e.kind = "signal_field";
+    e.signal = f.signal;
+    e.link = ntcip::to_string(f.link);
+    e.preempt_state = f.preempt_state ? ntcip::to_string(*f.preempt_state) : "";
+    e.call_on = f.call_on;
+    e.reason = f.last_error;
+    std::string key = e.link + '|' + e.preempt_state + '|' + (f.call_on ? '1' : '0');
+    auto [it, fresh] = shown_field_state_.try_emplace(f.signal);
+    if (!fresh && it->second == key) continue;
+    it->second = std::move(key);
+    e.time_s = now_s;
+    emit(std::move(e));
+  }
+}
+
 void DispatchService::drain_preemption_events(Staged& staged) {
   std::vector<std::pair<NodeId, double>> touched;
   for (const auto& e : preemption_.take_events()) {

@@ -136,7 +136,7 @@ struct CongestionResult {
 // built by the codec.
 struct DispatchEvent {
   std::string kind;  // mission_created, mission_completed, mission_cancelled, route_changed, position,
-                     // preemption_<kind>, congestion_applied, signal_state
+                     // preemption_<kind>, congestion_applied, signal_state, signal_call, signal_field
   MissionId mission = 0;
   std::string reason;
   double time_s = 0;
@@ -154,6 +154,10 @@ struct DispatchEvent {
   std::optional<NodeId> signal;
   std::string state;
   std::optional<std::size_t> edges_changed;
+  // A signal_field event's field controller: its link, its own preempt state, whether Corridor calls.
+  std::string link;
+  std::string preempt_state;
+  std::optional<bool> call_on;
 };
 
 }  // namespace corridor::server

@@ -210,6 +210,9 @@ json event_to_json(const DispatchEvent& e) {
   if (e.signal) j["signal"] = e.signal->v;
   if (!e.state.empty()) j["state"] = e.state;
   if (e.edges_changed) j["edges_changed"] = *e.edges_changed;
+  if (!e.link.empty()) j["link"] = e.link;
+  if (!e.preempt_state.empty()) j["preempt_state"] = e.preempt_state;
+  if (e.call_on) j["call_on"] = *e.call_on;
   return j;
 }
 

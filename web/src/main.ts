@@ -160,6 +160,7 @@ async function start(me: Me): Promise<void> {
     store.dispatch({ type: 'select', mission: id });
     void sync.refreshRoutes(id);
     void sync.refreshMission(id);
+    void sync.refreshCalls(id);
   };
   vehicles.onClick((v) => {
     if (v.mission !== null && v.mission !== undefined) select(v.mission);

@@ -1,5 +1,6 @@
 import { describe, expect, it } from 'vitest';
 import { reduce } from '../src/store/reducer';
+import type { Signal, SignalCall } from '../src/api/types';
 import { initialState, type Action, type State } from '../src/store/state';
 import { T0, ev, mission, position, route, signal, vehicle } from './fixtures';
 
@@ -155,5 +156,54 @@ describe('reducer: snapshot then events', () => {
     expect(Object.keys(s.missions).map(Number)).toEqual([1, 2]);
     expect(Object.keys(s.vehicles)).toEqual(['v']);
     expect(s.signals[3].state).toBe('held');
+  });
+});
+
+describe('reducer: field controllers', () => {
+  const fielded = (): Signal => ({
+    ...signal(408),
+    field: { controller: 'ctl-408', link: 'up', call_on: false, lights_reported: true, answers: 10 },
+  });
+  const start = (): State =>
+    replay([{ type: 'snapshot', missions: [mission(1)], vehicles: [], signals: [fielded(), signal(112)], nowMs: T0 * 1000 }]);
+
+  it("follows a controller's link, its preempt state and Corridor's call from signal_field events", () => {
+    const s = replay(
+      [
+        event(ev(1, 'signal_field', { signal: 408, link: 'up', call_on: true, preempt_state: 'entryStarted' })),
+        event(ev(2, 'signal_field', { signal: 408, link: 'up', call_on: true, preempt_state: 'dwell' })),
+      ],
+      start(),
+    );
+    expect(s.signals[408].field).toMatchObject({ link: 'up', call_on: true, preempt_state: 'dwell' });
+    const lost = replay([event(ev(3, 'signal_field', { signal: 408, link: 'unreachable', call_on: true, preempt_state: '', reason: 'timeout' }))], s);
+    expect(lost.signals[408].field?.link).toBe('unreachable');
+    expect(lost.signals[408].field?.preempt_state).toBeUndefined();
+    expect(lost.signals[408].field?.error).toBe('timeout');
+    const back = replay([event(ev(4, 'signal_field', { signal: 408, link: 'up', call_on: false, preempt_state: 'notActive' }))], lost);
+    expect(back.signals[408].field).toMatchObject({ link: 'up', call_on: false, preempt_state: 'notActive' });
+    expect(back.signals[408].field?.error).toBeUndefined();
+  });
+
+  it('ignores a signal_field event for a signal without a controller, or with a link state it does not know', () => {
+    const s = replay(
+      [
+        event(ev(1, 'signal_field', { signal: 112, link: 'up', call_on: true })),
+        event(ev(2, 'signal_field', { signal: 408, link: 'sideways', call_on: true })),
+      ],
+      start(),
+    );
+    expect(s.signals[112].field).toBeUndefined();
+    expect(s.signals[408].field).toMatchObject({ link: 'up', call_on: false });
+  });
+
+  it("keeps each mission's call records apart", () => {
+    const call = { signal: 408, mission: 1, vehicle_id: 'amb-1', controller: 'ctl-408', kind: 'preempt', number: 1, outcome: 'served' } as unknown as SignalCall;
+    const s = replay([
+      { type: 'calls', mission: 1, calls: [call] },
+      { type: 'calls', mission: 2, calls: [] },
+    ]);
+    expect(s.calls[1]).toHaveLength(1);
+    expect(s.calls[2]).toEqual([]);
   });
 });

@@ -56,6 +56,7 @@ function fakeServer() {
     vehicles: vi.fn(async () => [vehicle('amb-1', { mission: 1 })]),
     signals: vi.fn(async () => [signal(408)]),
     routes: vi.fn(async () => []),
+    missionCalls: vi.fn(async () => []),
   } satisfies SyncApi;
   return Object.assign(state, { api });
 }

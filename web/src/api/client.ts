@@ -12,6 +12,7 @@ import type {
   PositionResult,
   RouteRevision,
   Signal,
+  SignalCall,
   Ticket,
   Vehicle,
 } from './types';
@@ -108,6 +109,24 @@ export class ApiClient {
   }
   async signals(): Promise<Signal[]> {
     return (await this.request<{ signals: Signal[] }>('GET', '/v1/signals')).signals;
+  }
+  /** The call records of a mission's signals on field controllers, newest first. */
+  async missionCalls(id: number): Promise<SignalCall[]> {
+    return (await this.request<{ calls: SignalCall[] }>('GET', `/v1/missions/${id}/calls`)).calls;
+  }
+  /** The same records as the server's CSV export (a link cannot carry the bearer token). */
+  async missionCallsCsv(id: number): Promise<string> {
+    const headers: Record<string, string> = { Accept: 'text/csv' };
+    if (this.token) headers.Authorization = `Bearer ${this.token}`;
+    let response: Response;
+    try {
+      response = await this.fetchImpl(`${this.base}/v1/missions/${id}/calls?format=csv`, { method: 'GET', headers, cache: 'no-store' });
+    } catch (e) {
+      throw new ApiError(0, 'network', `cannot reach the server: ${(e as Error).message}`);
+    }
+    const text = await response.text();
+    if (!response.ok) throw new ApiError(response.status, `http_${response.status}`, `GET calls CSV: HTTP ${response.status}`);
+    return text;
   }
 }
 

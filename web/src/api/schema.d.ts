@@ -1445,12 +1445,18 @@ export interface components {
         };
         /** @description One WebSocket message. Clients must ignore types and fields they do not know. */
         Event: {
+            /** @description signal_field: Corridor calls a preempt or phase control there now */
+            call_on?: boolean;
             edges_changed?: number;
             eta_s?: number | null;
             heading_deg?: number | null;
             lat?: number;
+            /** @description signal_field: up, degraded or unreachable */
+            link?: string;
             lon?: number;
             mission: number | null;
+            /** @description signal_field: the controller's own preemptState for the preempt Corridor calls (notActive, entryStarted, trackService, dwell, ...), absent when it has not answered */
+            preempt_state?: string;
             reason: string;
             revision?: number;
             /** @description Increases by event within one server process */
@@ -1460,7 +1466,7 @@ export interface components {
             speed_mps?: number | null;
             state?: string;
             time_s: number;
-            /** @description mission_created, mission_completed, mission_cancelled, route_changed, position, preemption_scheduled, preemption_started, preemption_released, preemption_deferred, signal_state, congestion_applied, ... */
+            /** @description mission_created, mission_completed, mission_cancelled, route_changed, position, preemption_scheduled, preemption_started, preemption_released, preemption_deferred, signal_state, signal_call (a field controller's call record changed: state is its outcome), signal_field (a field controller's link, preempt state or call changed), congestion_applied, ... */
             type: string;
             vehicle_id?: string;
         };

@@ -1,7 +1,7 @@
 // Signal markers coloured by state: normal program, preemption scheduled, held green for the
 // emergency vehicle, recovering. A marker is created once per signal and only its class changes.
 import L from 'leaflet';
-import type { Signal } from '../api/types';
+import type { Signal, SignalField } from '../api/types';
 import type { State } from '../store/state';
 
 interface SignalMarker {
@@ -15,6 +15,12 @@ const STATE_LABEL: Record<string, string> = {
   held: 'held green for the emergency vehicle',
   recovering: 'recovering to its program',
 };
+
+/** A field controller in a line: its id, link, and its own preempt state where it reports one. */
+export function fieldText(f: SignalField): string {
+  const preempt = f.preempt ? ` · preempt ${f.preempt}${f.preempt_state ? ` ${f.preempt_state}` : ''}` : f.preempt_state ? ` · ${f.preempt_state}` : '';
+  return `controller ${f.controller} ${f.link}${f.call_on ? ' · called' : ''}${preempt}${f.error ? ` · ${f.error}` : ''}`;
+}
 
 export class SignalLayer {
   private readonly markers = new Map<number, SignalMarker>();
@@ -44,9 +50,11 @@ export class SignalLayer {
       if (el) {
         el.dataset.state = s.state;
         const dot = el.firstElementChild;
-        if (dot) dot.className = `signal-marker state-${s.state}`;
+        if (dot) dot.className = `signal-marker state-${s.state}${s.field ? ` link-${s.field.link}` : ''}`;
+        if (s.field) el.dataset.link = s.field.link;
+        else delete el.dataset.link;
         const lights = s.lights.map((l) => `${l.movement}: ${l.light}`).join(', ');
-        el.title = `Signal ${s.id} (OSM ${s.osm_node}) · ${STATE_LABEL[s.state] ?? s.state} · ${s.mode}${lights ? ` · ${lights}` : ''}`;
+        el.title = `Signal ${s.id} (OSM ${s.osm_node}) · ${STATE_LABEL[s.state] ?? s.state} · ${s.mode}${lights ? ` · ${lights}` : ''}${s.field ? ` · ${fieldText(s.field)}` : ''}`;
       }
       sm.signal = s;
     }

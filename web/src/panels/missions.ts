@@ -1,13 +1,16 @@
 // Mission panel: active and recent missions (vehicle, priority, state, ETA countdown), and the
-// selected mission's directions, route changes with reasons, and preemption schedule. Rows are
+// selected mission's directions, route changes with reasons, its preemption schedule with what each
+// field controller reports beside Corridor's plan, and its calls on field controllers. Rows are
 // keyed by mission id and updated in place; the countdown ticks once a second.
 import type { ApiClient } from '../api/client';
 import { ApiError } from '../api/client';
-import type { Mission, Step } from '../api/types';
+import type { Mission, SignalCall, Step } from '../api/types';
 import { clockTime, etaLabel, formatDuration } from '../store/eta';
 import type { State } from '../store/state';
 import type { Store } from '../store/store';
 import { byTestId, fmtDistance, h, setText } from './dom';
+
+const NO_CALLS: SignalCall[] = [];
 
 interface Row {
   tr: HTMLTableRowElement;
@@ -47,6 +50,10 @@ export class MissionPanel {
   private order = '';
   private detailMission: Mission | null = null;
   private detailHistory: unknown = null;
+  private detailCalls: unknown = null;
+  private detailSignals: unknown = null;
+  /** The schedule's controller cells by signal, refreshed as the controllers report. */
+  private controllerCells = new Map<number, HTMLTableCellElement>();
 
   constructor(
     private readonly store: Store,
@@ -55,12 +62,21 @@ export class MissionPanel {
     private readonly onSelect: (id: number) => void,
   ) {
     byTestId('cancel-mission').onclick = () => void this.cancel();
+    byTestId('calls-csv').onclick = () => void this.exportCalls();
   }
 
   render(state: State, previous: State | null, nowMs: number): void {
     const missionsChanged = !previous || previous.missions !== state.missions || previous.selectedMission !== state.selectedMission;
     if (missionsChanged) this.renderList(state, nowMs);
-    if (missionsChanged || !previous || previous.routeHistory !== state.routeHistory) this.renderDetail(state, nowMs);
+    if (
+      missionsChanged ||
+      !previous ||
+      previous.routeHistory !== state.routeHistory ||
+      previous.signals !== state.signals ||
+      previous.calls !== state.calls
+    ) {
+      this.renderDetail(state, nowMs);
+    }
   }
 
   /** The once-a-second countdown: ETA cells only. */
@@ -148,22 +164,45 @@ export class MissionPanel {
         );
       }
       if (!prev || prev.id !== m.id || prev.preemption !== m.preemption) {
+        this.controllerCells.clear();
         byTestId('preemption-schedule').replaceChildren(
           ...m.preemption.map((e) => {
+            const controller = h('td', { testid: `controller-${e.signal}` });
+            this.controllerCells.set(e.signal, controller);
             const tr = h('tr', { testid: `preemption-${e.signal}` }, [
               h('td', { text: String(e.signal), title: `OSM node ${e.osm_node} · ${e.movement} · phase ${e.phase} · congestion ${e.congestion}` }),
               h('td', { text: clockTime(e.start_s) }),
               h('td', { text: clockTime(e.arrival_s) }),
               h('td', { text: clockTime(e.release_s) }),
               h('td', { text: `${e.state}${e.deferred ? ' (deferred)' : ''}` }),
+              controller,
             ]);
             tr.dataset.state = e.state;
             return tr;
           }),
         );
+        this.detailSignals = null;
       }
       this.detailMission = m;
     }
+    if (state.signals !== this.detailSignals) {
+      for (const [signal, td] of this.controllerCells) {
+        const f = state.signals[signal]?.field;
+        setText(td, f ? `${f.preempt_state ?? '–'} · ${f.link}` : '–');
+        td.className = f ? `link-${f.link}` : '';
+        td.title = f ? `controller ${f.controller}${f.preempt ? ` · preempt ${f.preempt}` : ''}${f.call_on ? ' · called' : ''}${f.error ? ` · ${f.error}` : ''}` : 'not on a field controller';
+        if (f?.preempt_state) td.dataset.preemptState = f.preempt_state;
+        else delete td.dataset.preemptState;
+      }
+      this.detailSignals = state.signals;
+    }
+    const calls = state.calls[m.id] ?? NO_CALLS;
+    if (calls !== this.detailCalls) {
+      byTestId('calls').replaceChildren(...calls.map((c) => callRow(c)));
+      this.detailCalls = calls;
+    }
+    // Shown for a mission over field controllers, or one that has called them.
+    byTestId('calls-panel').hidden = calls.length === 0 && !m.preemption.some((e) => state.signals[e.signal]?.field !== undefined);
     const history = state.routeHistory[m.id];
     if (history !== this.detailHistory) {
       byTestId('route-history').replaceChildren(
@@ -183,6 +222,26 @@ export class MissionPanel {
     }
   }
 
+  private async exportCalls(): Promise<void> {
+    const id = this.store.getState().selectedMission;
+    if (id === null) return;
+    const error = byTestId('mission-error');
+    error.textContent = '';
+    try {
+      const csv = await this.api.missionCallsCsv(id);
+      const url = URL.createObjectURL(new Blob([csv], { type: 'text/csv' }));
+      const a = document.createElement('a');
+      a.href = url;
+      a.download = `mission-${id}-calls.csv`;
+      document.body.append(a);
+      a.click();
+      a.remove();
+      setTimeout(() => URL.revokeObjectURL(url), 10_000);
+    } catch (e) {
+      error.textContent = e instanceof ApiError ? `${e.code}: ${e.message}` : String(e);
+    }
+  }
+
   private async cancel(): Promise<void> {
     const id = this.store.getState().selectedMission;
     if (id === null) return;
@@ -195,4 +254,25 @@ export class MissionPanel {
       error.textContent = e instanceof ApiError ? `${e.code}: ${e.message}` : String(e);
     }
   }
+}
+
+function optionalTime(s: number | undefined): string {
+  return s === undefined ? '–' : clockTime(s);
+}
+
+/** One call record: the signal, the call (preempt N or phase control), its four times and outcome. */
+export function callRow(c: SignalCall): HTMLTableRowElement {
+  const call = c.kind === 'preempt' ? `preempt ${c.preempt ?? '?'} · ${c.approach}` : `priority ${c.priority} · ${c.approach}`;
+  const tr = h('tr', { testid: `call-${c.id}` }, [
+    h('td', { text: String(c.signal), title: `controller ${c.controller}` }),
+    h('td', { text: call }),
+    h('td', { text: clockTime(c.request_s) }),
+    h('td', { text: optionalTime(c.grant_s) }),
+    h('td', { text: optionalTime(c.release_s) }),
+    h('td', { text: optionalTime(c.clear_s) }),
+    h('td', { text: c.outcome }),
+  ]);
+  tr.className = `outcome-${c.outcome}`;
+  tr.dataset.outcome = c.outcome;
+  return tr;
 }

@@ -1,7 +1,7 @@
 // The one reducer: (state, action) -> state, pure, so that a test can replay a stream of server
 // events and REST snapshots and check where it ends. Unknown event types and fields are logged
 // and otherwise ignored.
-import type { Mission, ScheduleEntry, ServerEvent, Signal, Vehicle } from '../api/types';
+import type { Mission, ScheduleEntry, ServerEvent, Signal, SignalField, Vehicle } from '../api/types';
 import { EVENT_LOG_LIMIT, FADED_ROUTE_MS, initialState, type Action, type State } from './state';
 
 /** How many finished (completed or cancelled) missions the console keeps for the "recent" list. */
@@ -15,6 +15,8 @@ const PREEMPTION_ENTRY_STATE: Record<string, string> = {
   cancelled: 'cancelled',
   expired: 'expired',
 };
+
+const LINK_STATES = new Set(['up', 'degraded', 'unreachable']);
 
 export function reduce(state: State, action: Action): State {
   switch (action.type) {
@@ -50,6 +52,8 @@ export function reduce(state: State, action: Action): State {
     }
     case 'routes':
       return { ...state, routeHistory: { ...state.routeHistory, [action.mission]: action.revisions } };
+    case 'calls':
+      return { ...state, calls: { ...state.calls, [action.mission]: action.calls } };
     case 'select':
       return state.selectedMission === action.mission ? state : { ...state, selectedMission: action.mission };
     case 'expire': {
@@ -190,6 +194,17 @@ export function applyEvent(state: State, e: ServerEvent): State {
   } else if (type === 'signal_state' && typeof e.signal === 'number' && typeof e.state === 'string') {
     const s = next.signals[e.signal];
     if (s && s.state !== e.state) next = { ...next, signals: { ...next.signals, [e.signal]: { ...s, state: e.state as Signal['state'] } } };
+  } else if (type === 'signal_field' && typeof e.signal === 'number' && typeof e.link === 'string') {
+    // A field controller's link, its own preempt state and Corridor's call, as they change.
+    const s = next.signals[e.signal];
+    if (s?.field && LINK_STATES.has(e.link)) {
+      const field: SignalField = { ...s.field, link: e.link as SignalField['link'], call_on: e.call_on ?? s.field.call_on };
+      if (typeof e.preempt_state === 'string' && e.preempt_state !== '') field.preempt_state = e.preempt_state as SignalField['preempt_state'];
+      else delete field.preempt_state;
+      if (e.reason) field.error = e.reason;
+      else delete field.error;
+      next = { ...next, signals: { ...next.signals, [e.signal]: { ...s, field } } };
+    }
   }
   return next;
 }

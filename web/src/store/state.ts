@@ -1,6 +1,6 @@
 // The console's whole state and the actions that change it. Only reducer.ts turns an action into
 // a new state; everything else reads.
-import type { Me, Mission, RouteRevision, ServerEvent, Signal, Vehicle } from '../api/types';
+import type { Me, Mission, RouteRevision, ServerEvent, Signal, SignalCall, Vehicle } from '../api/types';
 
 export type ConnectionStatus = 'idle' | 'connecting' | 'live' | 'reconnecting' | 'offline';
 
@@ -27,6 +27,8 @@ export interface State {
   vehicles: Record<string, Vehicle>;
   signals: Record<number, Signal>;
   routeHistory: Record<number, RouteRevision[]>;
+  /** Per mission, its call records on field controllers (fetched for the selected mission). */
+  calls: Record<number, SignalCall[]>;
   previousRoutes: Record<number, FadedRoute>;
   /** Per mission, time_s of the latest event that set its position or ETA. */
   missionEventS: Record<number, number>;
@@ -65,6 +67,7 @@ export type Action =
     }
   | { type: 'missions'; missions: Mission[]; nowMs: number }
   | { type: 'routes'; mission: number; revisions: RouteRevision[] }
+  | { type: 'calls'; mission: number; calls: SignalCall[] }
   | { type: 'select'; mission: number | null }
   | { type: 'expire'; nowMs: number }
   | { type: 'reset' };
@@ -77,6 +80,7 @@ export function initialState(): State {
     vehicles: {},
     signals: {},
     routeHistory: {},
+    calls: {},
     previousRoutes: {},
     missionEventS: {},
     events: [],

@@ -14,7 +14,7 @@ export interface SocketLike {
   close(): void;
 }
 
-export type SyncApi = Pick<ApiClient, 'ticket' | 'missions' | 'mission' | 'vehicles' | 'signals' | 'routes'>;
+export type SyncApi = Pick<ApiClient, 'ticket' | 'missions' | 'mission' | 'vehicles' | 'signals' | 'routes' | 'missionCalls'>;
 
 export interface SyncDeps {
   api: SyncApi;
@@ -148,9 +148,9 @@ export class Sync {
     const id = typeof e.mission === 'number' ? e.mission : null;
     if (id === null) return;
     if (REFRESH_ON.has(e.type) || !this.deps.store.getState().missions[id]) this.refreshMission(id);
-    if ((e.type === 'route_changed' || e.type === 'mission_created') && this.deps.store.getState().selectedMission === id) {
-      this.refreshRoutes(id);
-    }
+    const selected = this.deps.store.getState().selectedMission === id;
+    if ((e.type === 'route_changed' || e.type === 'mission_created') && selected) this.refreshRoutes(id);
+    if (e.type === 'signal_call' && selected) this.refreshCalls(id);
   }
 
   /** REST snapshot after the stream opened: events that arrived meanwhile wait in the reducer. */
@@ -169,7 +169,10 @@ export class Sync {
         if (m.state === 'active' && !listed.has(m.id)) this.refreshMission(m.id);
       }
       const selected = this.deps.store.getState().selectedMission;
-      if (selected !== null) this.refreshRoutes(selected);
+      if (selected !== null) {
+        this.refreshRoutes(selected);
+        this.refreshCalls(selected);
+      }
       this.attempt = 0;
       this.deps.store.dispatch({ type: 'connection', status: 'live', attempt: 0 });
     } catch (e) {
@@ -216,6 +219,13 @@ export class Sync {
     return this.coalesce(`r${id}`, async () => {
       const revisions = await this.deps.api.routes(id);
       this.deps.store.dispatch({ type: 'routes', mission: id, revisions });
+    });
+  }
+
+  refreshCalls(id: number): Promise<void> {
+    return this.coalesce(`c${id}`, async () => {
+      const calls = await this.deps.api.missionCalls(id);
+      this.deps.store.dispatch({ type: 'calls', mission: id, calls });
     });
   }
 
