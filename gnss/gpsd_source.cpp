@@ -1,6 +1,7 @@
 #include "gnss/gpsd_source.hpp"
 
 #include <gps.h>
+#include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
 #include <cerrno>
@@ -47,7 +48,20 @@ GnssReport report_of(const gps_fix_t& f) {
   return r;
 }
 
+bool is_tpv(const char* message) { return std::strncmp(message, "{\"class\":\"TPV\"", 14) == 0; }
+
 }  // namespace
+
+std::optional<GnssReport> decode_gpsd_message(std::string message) {
+  gps_data_t data{};
+  // libgps parses in place and stops at the NUL. Its parser (3.22) never returns on some malformed
+  // objects, such as {"class":"TPV""class":"TPV" (found by gnss_fuzzer), so only well-formed JSON reaches it.
+  if (!is_tpv(message.c_str()) || !nlohmann::json::accept(message)) return std::nullopt;
+  if (gps_unpack(message.data(), &data) != 0) return std::nullopt;
+  // A TPV always carries its mode.
+  if ((data.set & MODE_SET) == 0) return std::nullopt;
+  return report_of(data.fix);
+}
 
 GpsdSource::GpsdSource(std::string host, std::string port, GpsdSourceOptions options)
     : host_(std::move(host)), port_(std::move(port)), options_(options) {
@@ -79,7 +93,7 @@ std::optional<GnssReport> GpsdSource::read_one(double wait_s) {
   }
   if (rc == 0 || (conn_->data.set & PACKET_SET) == 0) return std::nullopt;
   // Other classes add to `set` rather than replace it: a TPV is told by its message.
-  if (std::strncmp(message, "{\"class\":\"TPV\"", 14) != 0) return std::nullopt;
+  if (!is_tpv(message)) return std::nullopt;
   return report_of(conn_->data.fix);
 }
 

@@ -24,6 +24,10 @@ struct GpsdSourceOptions {
   double idle_timeout_s = 10.0;
 };
 
+// One message of gpsd's JSON protocol decoded by libgps as a live stream is: the report when it is a
+// TPV, nullopt for every other class and for what libgps cannot read.
+[[nodiscard]] std::optional<GnssReport> decode_gpsd_message(std::string message);
+
 class GpsdSource {
  public:
   // Connects at once; throws GnssError when gpsd cannot be reached.

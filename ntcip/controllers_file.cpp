@@ -17,7 +17,8 @@ using nlohmann::json;
 [[noreturn]] void fail(const std::string& where, const std::string& what) { throw ControllersFileError(where + ": " + what); }
 
 void only_keys(const json& j, const std::string& where, std::initializer_list<const char*> keys) {
-  for (const auto& [key, value] : j.items()) {
+  for (const auto& item : j.items()) {
+    const std::string& key = item.key();
     if (std::find_if(keys.begin(), keys.end(), [&](const char* k) { return key == k; }) == keys.end()) {
       fail(where + "." + key, "unknown field");
     }
@@ -256,7 +257,7 @@ std::vector<ControllerConfig> read_controllers_file(const std::filesystem::path&
   json j;
   try {
     j = json::parse(in);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // a syntax error, or a number too large for a double (406)
     throw ControllersFileError("'" + file.string() + "' is not JSON: " + e.what());
   }
   try {

@@ -59,7 +59,7 @@ AnalyticalGraph parse(std::string_view json_text, const std::string& origin) {
   nlohmann::json doc;
   try {
     doc = nlohmann::json::parse(json_text);
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {  // a syntax error, or a number too large for a double
     fail(origin, std::string("not valid JSON (") + e.what() + ")");
   }
   if (!doc.is_object()) fail(origin, "the top level must be a JSON object");

@@ -4,6 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
+
+#include "tests/temp_dir.hpp"
+
 namespace corridor::ntcip {
 namespace {
 
@@ -85,6 +89,29 @@ TEST(ControllersFile, EveryErrorNamesItsField) {
   twice[1]["id"] = "another";
   twice[1]["port"] = 9;
   EXPECT_NE(error_of(twice).find("has two controllers"), std::string::npos);
+}
+
+// A file that is not JSON, or holds a number no double can hold (found by controllers_fuzzer), is
+// refused as not JSON, naming the file, rather than escaping as JSON's own exception.
+TEST(ControllersFile, AFileThatIsNotJsonOrOverflowsANumberIsRefusedNamingTheFile) {
+  const corridor::testing::TempDir dir("controllers");
+  const auto write = [&](const std::string& name, const std::string& text) {
+    const auto p = dir.path() / name;
+    std::ofstream(p) << text;
+    return p;
+  };
+  for (const auto& [name, text] : {std::pair<std::string, std::string>{"cut.json", R"([{"osm_node_id": 1, "port": )"},
+                                   {"huge.json", R"([{"osm_node_id": 1, "port": 161, "keepalive_s": 2.0E1111111111}])"}}) {
+    const auto p = write(name, text);
+    try {
+      (void)read_controllers_file(p);
+      ADD_FAILURE() << name << " was accepted";
+    } catch (const ControllersFileError& e) {
+      EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("is not JSON"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_THROW((void)read_controllers_file(dir.path() / "missing.json"), ControllersFileError);
 }
 
 }  // namespace
