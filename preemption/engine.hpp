@@ -100,6 +100,9 @@ struct ScheduleEntry {
   std::optional<NodeId> flush_for;
 };
 
+// Planned or active: the entry still has a hold to give.
+[[nodiscard]] inline bool is_live(const ScheduleEntry& e) { return e.state == EntryState::planned || e.state == EntryState::active; }
+
 struct PreemptionEvent {
   double time_s;
   MissionId mission;
