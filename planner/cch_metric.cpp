@@ -7,45 +7,9 @@
 #include <stdexcept>
 #include <string>
 
-#include "planner/gallop.hpp"
+#include "planner/cch_lower_triangles.hpp"
 
 namespace corridor::planner {
-
-CchMetric::CchMetric(const CchTopology& topology, const TravelCost& cost, CchMetricOptions options)
-    : topology_(&topology),
-      cost_(&cost),
-      options_(options),
-      up_(topology.arc_count()),
-      down_(topology.arc_count()),
-      ways_(std::size_t{topology.arc_count()} << (options.lazy_rises ? 2 : 1)),
-      lazy_shift_(options.lazy_rises ? 1 : 0),
-      slot_(topology.arc_count(), 0),
-      queue_(topology.arc_count()) {
-  if (options_.lazy_rises) {
-    inputs_.resize(topology.arc_count());
-    // Every weight of the full customization below is exact: found so in batch 1, before any
-    // change (and no subtree has seen a rise since).
-    for (std::uint32_t arc = 0; arc < topology.arc_count(); ++arc) {
-      for (const bool upward : {true, false}) {
-        ways_[place_of(arc, upward) + 1].lazy = LazyWay{batch_, kNoCchArc, std::numeric_limits<float>::infinity(), 0};
-      }
-    }
-  }
-  if (&topology.turns() != &cost.graph().turns()) {
-    throw std::invalid_argument("the contraction hierarchy was built for another graph than the cost model's");
-  }
-  open_ = open_inputs();
-  customize_all(open_);
-  for (std::uint32_t arc = 0; arc < topology.arc_count(); ++arc) {
-    up_[arc] = way(arc, true).weight;
-    down_[arc] = way(arc, false).weight;
-  }
-  build_open_lists();
-  if (options_.lazy_rises) {
-    marks_.resize(topology.vertex_count());
-    for (std::uint32_t r = 0; r < topology.vertex_count(); ++r) marks_[r] = {batch_, topology.parent(r)};
-  }
-}
 
 void CchMetric::mark_changed(std::uint32_t arc) {
   if (!options_.lazy_rises || arc == kNoCchArc) return;
@@ -72,147 +36,6 @@ double CchMetric::input_s(std::uint32_t index) const {
   const EdgeId onto = turns.edge_of(a.other);
   const double turn = cost_->turn_cost_s(in, a, onto);
   return turn >= kInfCost ? kInfCost : add_cost(turn, cost_->transit_s(onto));
-}
-
-void CchMetric::customize_all(HugePageVector<std::uint8_t>& open) {
-  const CchTopology& t = *topology_;
-  for (std::uint32_t arc = 0; arc < t.arc_count(); ++arc) {
-    const CchTopology::Input& in = t.input(arc);
-    way(arc, true).weight = in.up == kNoCchArc ? kInfCost : input_s(in.up);
-    way(arc, false).weight = in.down == kNoCchArc ? kInfCost : input_s(in.down);
-    if (options_.lazy_rises) inputs_[arc] = {way(arc, true).weight, way(arc, false).weight};
-  }
-  // Basic customization: every lower triangle {x, a, b} (x lowest) offers a→x→b and b→x→a. Going
-  // up by x, an arc's weight is final before any arc above it reads it. The same sweep opens a→b
-  // where a→x and x→b are open, whatever they weigh today.
-  for (std::uint32_t x = 0; x < t.vertex_count(); ++x) {
-    const auto ups = t.up(x);
-    const std::uint32_t base = t.first_up(x);
-    for (std::size_t i = 0; i < ups.size(); ++i) {
-      const std::uint32_t xa = base + static_cast<std::uint32_t>(i);
-      if (open[xa] == 0) continue;
-      const double a_to_x = way(xa, false).weight;
-      const double x_to_a = way(xa, true).weight;
-      const bool a_to_x_open = (open[xa] & kDown) != 0, x_to_a_open = (open[xa] & kUp) != 0;
-      // The higher neighbours of x above a are higher neighbours of a too (chordality): walk both
-      // ascending lists together to find the arcs {a, b}.
-      const auto a_ups = t.up(ups[i]);
-      std::size_t k = 0;
-      for (std::size_t j = i + 1; j < ups.size(); ++j) {
-        while (a_ups[k] < ups[j]) ++k;
-        const std::uint32_t ab = t.first_up(ups[i]) + static_cast<std::uint32_t>(k);
-        const std::uint32_t xb = base + static_cast<std::uint32_t>(j);
-        if (a_to_x_open && (open[xb] & kUp) != 0) open[ab] |= kUp;    // a→x→b
-        if (x_to_a_open && (open[xb] & kDown) != 0) open[ab] |= kDown;  // b→x→a
-        const double up = add_cost(a_to_x, way(xb, true).weight);
-        const double down = add_cost(way(xb, false).weight, x_to_a);
-        // A lazy metric keeps the best of the ways that lost (lower_rival).
-        if (up < way(ab, true).weight) {
-          if (options_.lazy_rises) lower_rival(ab, true, way(ab, true).weight);
-          way(ab, true).weight = up;
-          set_witness(ab, true, Witness{xa, xb}, x);
-        } else if (options_.lazy_rises) {
-          lower_rival(ab, true, up);
-        }
-        if (down < way(ab, false).weight) {
-          if (options_.lazy_rises) lower_rival(ab, false, way(ab, false).weight);
-          way(ab, false).weight = down;
-          set_witness(ab, false, Witness{xa, xb}, x);
-        } else if (options_.lazy_rises) {
-          lower_rival(ab, false, down);
-        }
-      }
-    }
-  }
-}
-
-HugePageVector<std::uint8_t> CchMetric::open_inputs() const {
-  const CchTopology& t = *topology_;
-  // An input direction is open unless the profile closes it for good: a restriction or U-turn
-  // rule (turn_s), or an edge the vehicle does not fit. The overlay is not read.
-  const auto input_open = [&](std::uint32_t index) {
-    if (index == kNoCchArc) return false;
-    const maps::TurnArc& a = t.turn_arc(index);
-    return cost_->turn_s(a) < kInfCost && !cost_->blocked(t.turns().edge_of(a.other));
-  };
-  HugePageVector<std::uint8_t> open(t.arc_count(), 0);
-  for (std::uint32_t arc = 0; arc < t.arc_count(); ++arc) {
-    const CchTopology::Input& in = t.input(arc);
-    open[arc] = static_cast<std::uint8_t>((input_open(in.up) ? kUp : 0) | (input_open(in.down) ? kDown : 0));
-  }
-  return open;
-}
-
-void CchMetric::build_open_lists() {
-  const CchTopology& t = *topology_;
-  const HugePageVector<std::uint8_t>& open = open_;
-  // The four neighbour lists, by counting. Arc ids ascend by tail and, within a tail, by head, so
-  // filling in id order keeps every list ascending.
-  const std::size_t n = t.vertex_count();
-  for (OpenLists* l : {&lower_out_, &lower_in_, &upper_out_, &upper_in_}) l->first.assign(n + 2, 0);
-  for (std::uint32_t arc = 0; arc < t.arc_count(); ++arc) {
-    const std::uint32_t x = t.tail(arc), y = t.head(arc);
-    if ((open[arc] & kUp) != 0) {  // x→y
-      ++lower_in_.first[y + 2];
-      ++upper_out_.first[x + 2];
-    }
-    if ((open[arc] & kDown) != 0) {  // y→x
-      ++lower_out_.first[y + 2];
-      ++upper_in_.first[x + 2];
-    }
-  }
-  for (OpenLists* l : {&lower_out_, &lower_in_, &upper_out_, &upper_in_}) {
-    for (std::size_t r = 2; r < l->first.size(); ++r) l->first[r] += l->first[r - 1];
-    l->entries.resize(l->first.back());
-  }
-  // first[r + 1] is the next free slot of r's list while filling; afterwards first[r] begins it.
-  const auto put = [](OpenLists& l, std::uint32_t r, std::uint32_t neighbour, std::uint32_t arc) {
-    l.entries[l.first[r + 1]++] = CchDownArc{neighbour, arc};
-  };
-  for (std::uint32_t arc = 0; arc < t.arc_count(); ++arc) {
-    const std::uint32_t x = t.tail(arc), y = t.head(arc);
-    if ((open[arc] & kUp) != 0) {
-      put(lower_in_, y, x, arc);
-      put(upper_out_, x, y, arc);
-    }
-    if ((open[arc] & kDown) != 0) {
-      put(lower_out_, y, x, arc);
-      put(upper_in_, x, y, arc);
-    }
-  }
-  for (OpenLists* l : {&lower_out_, &lower_in_, &upper_out_, &upper_in_}) l->first.pop_back();
-}
-
-namespace {
-
-// A lambda, not a function: gallop_to takes the key by value, and a function pointer there is not
-// inlined.
-constexpr auto tail_of = [](const CchDownArc& d) { return d.tail; };
-
-}  // namespace
-
-template <class F>
-void CchMetric::for_each_lower_triangle(std::uint32_t arc, bool upward, F&& f) const {
-  const CchTopology& t = *topology_;
-  const std::uint32_t x = t.tail(arc), y = t.head(arc);
-  // Lower triangles {z, x, y}, z below x, open the way asked: x→z→y upward, y→z→x downward.
-  // Both lists ascend by z.
-  const auto zx = upward ? lower_out_.of(x) : lower_in_.of(x);
-  const auto zy = upward ? lower_in_.of(y) : lower_out_.of(y);
-  auto i = zx.begin();
-  auto j = zy.begin();
-  while (i != zx.end() && j != zy.end() && j->tail < x) {
-    if (i->tail < j->tail) {
-      i = gallop_to(i, zx.end(), j->tail, tail_of);
-    } else if (j->tail < i->tail) {
-      j = gallop_to(j, zy.end(), i->tail, tail_of);
-    } else {
-      const Witness z{i->arc, j->arc};
-      f(side_sum(z, upward), z);
-      ++i;
-      ++j;
-    }
-  }
 }
 
 CchMetric::Derived CchMetric::derive(std::uint32_t arc, bool upward) const {
@@ -376,7 +199,7 @@ CustomizationStats CchMetric::propagate(std::vector<std::uint32_t>& changed) {
     // y, a walk along its short ascending higher list.
     const auto between = [&](std::uint32_t z, std::size_t& k, std::size_t& m) {
       if (z < y) {
-        m = static_cast<std::size_t>(gallop_to(y_downs.begin() + static_cast<std::ptrdiff_t>(m), y_downs.end(), z, tail_of) -
+        m = static_cast<std::size_t>(gallop_to(y_downs.begin() + static_cast<std::ptrdiff_t>(m), y_downs.end(), z, cch_detail::tail_of) -
                                      y_downs.begin());
         assert(m < y_downs.size() && y_downs[m].tail == z);
         return y_downs[m].arc;
@@ -530,114 +353,6 @@ double CchMetric::settle(std::uint32_t arc, bool upward, std::vector<std::uint32
   if (best.via != own) set_witness(arc, upward, best.via, best.via.input() ? kNoCchArc : topology_->tail(best.via.to_tail));
   lazy(arc, upward).exact = batch_;
   return best.weight;
-}
-
-bool CchMetric::is_triangle(std::uint32_t arc, Witness w) const {
-  const CchTopology& t = *topology_;
-  const std::uint32_t n = t.arc_count();
-  return w.to_tail < n && w.to_head < n && t.tail(w.to_tail) == t.tail(w.to_head) &&
-         t.head(w.to_tail) == t.tail(arc) && t.head(w.to_head) == t.head(arc);
-}
-
-std::string CchMetric::invariant_violation() const {
-  const CchTopology& t = *topology_;
-  for (std::uint32_t arc = 0; arc < t.arc_count(); ++arc) {
-    for (const bool upward : {true, false}) {
-      const std::uint32_t input = upward ? t.input(arc).up : t.input(arc).down;
-      const double today = input == kNoCchArc ? kInfCost : input_s(input);
-      if (input_cost(arc, upward) != today) {
-        return "arc " + std::to_string(arc) + (upward ? " up" : " down") + " keeps input cost " +
-               std::to_string(input_cost(arc, upward)) + " but the turn costs " + std::to_string(today) + " today";
-      }
-    }
-    // The searches' copies of the weights are the metric's own (set_weight writes both).
-    if (up_[arc] != way(arc, true).weight || down_[arc] != way(arc, false).weight) {
-      return "arc " + std::to_string(arc) + "'s weights for the searches differ from the metric's";
-    }
-    const double up = derive(arc, true).weight, down = derive(arc, false).weight;
-    if (options_.lazy_rises) {
-      // Lower bounds: at or below what the triangles and the input give; witnesses may have risen.
-      if (up_s(arc) > up || down_s(arc) > down) {
-        return "arc " + std::to_string(arc) + " holds " + std::to_string(up_s(arc)) + "/" + std::to_string(down_s(arc)) +
-               " above what its triangles give, " + std::to_string(up) + "/" + std::to_string(down);
-      }
-      // The rival bounds every other way: the input where the witness is a triangle, and every
-      // open lower triangle but the witness.
-      for (const bool upward : {true, false}) {
-        const double rival = lazy(arc, upward).rival;
-        const Witness z = witness(arc, upward);
-        if (lazy(arc, upward).middle != (z.input() ? kNoCchArc : t.tail(z.to_tail))) {
-          return "arc " + std::to_string(arc) + (upward ? " up" : " down") + " keeps a middle not its witness's";
-        }
-        double other = z.input() ? kInfCost : input_cost(arc, upward);
-        for_each_lower_triangle(arc, upward, [&](double sum, Witness tri) {
-          if (tri != z) other = std::min(other, sum);
-        });
-        if (rival > other) {
-          return "arc " + std::to_string(arc) + (upward ? " up" : " down") + " has rival bound " +
-                 std::to_string(rival) + " above another way's " + std::to_string(other);
-        }
-      }
-      // A weight settle() would take as exact without looking is its witness's sum, over sides
-      // it would take as exact too: so, by induction, the cost of the path it unpacks to.
-      for (const bool upward : {true, false}) {
-        if (!known_exact(arc, upward)) continue;
-        const double w = way(arc, upward).weight;
-        const Witness z = witness(arc, upward);
-        double witnessed = input_cost(arc, upward);
-        if (!z.input()) {
-          if (!is_triangle(arc, z)) return "arc " + std::to_string(arc) + "'s witness is not a triangle";
-          if (!known_exact(z.to_tail, !upward) || !known_exact(z.to_head, upward)) {
-            return "arc " + std::to_string(arc) + (upward ? " up" : " down") +
-                   " is taken as exact over a side that is not";
-          }
-          witnessed = side_sum(z, upward);
-        }
-        if (witnessed != w) {
-          return "arc " + std::to_string(arc) + (upward ? " up" : " down") + " is taken as exact at " +
-                 std::to_string(w) + " but its witness gives " + std::to_string(witnessed);
-        }
-      }
-      continue;
-    }
-    if (up != up_s(arc) || down != down_s(arc)) {
-      return "arc " + std::to_string(arc) + " holds " + std::to_string(up_s(arc)) + "/" + std::to_string(down_s(arc)) +
-             " but its triangles give " + std::to_string(up) + "/" + std::to_string(down);
-    }
-    // Each finite weight's witness gives exactly it, so unpacking reproduces the weight.
-    const CchTopology::Input& in = t.input(arc);
-    for (const bool upward : {true, false}) {
-      const double w = way(arc, upward).weight;
-      if (w >= kInfCost) continue;
-      const Witness z = witness(arc, upward);
-      const std::uint32_t input = upward ? in.up : in.down;
-      double witnessed = kInfCost;
-      if (z.input()) {
-        if (input != kNoCchArc) witnessed = input_s(input);
-      } else if (is_triangle(arc, z)) {
-        witnessed = side_sum(z, upward);
-      }
-      if (witnessed != w) {
-        return "arc " + std::to_string(arc) + (upward ? " up" : " down") + " weighs " + std::to_string(w) +
-               " but its witness gives " + std::to_string(witnessed);
-      }
-    }
-  }
-  return {};
-}
-
-std::size_t CchMetric::memory_bytes() const {
-  return (up_.size() + down_.size()) * sizeof(double) + ways_.size() * sizeof(Slot) + inputs_.size() * sizeof(Inputs) +
-         slot_.size() * sizeof(std::uint32_t) + marks_.size() * sizeof(TreeMark) +
-         queue_.memory_bytes() +
-         pending_.capacity() * sizeof(Pending) +
-         [&] {
-           std::size_t bytes = 0;
-           for (const OpenLists* l : {&lower_out_, &lower_in_, &upper_out_, &upper_in_}) {
-             bytes += l->first.capacity() * sizeof(std::uint32_t) + l->entries.capacity() * sizeof(CchDownArc);
-           }
-           return bytes + open_.capacity();
-         }();
 }
 
 }  // namespace corridor::planner
