@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "maps/errors.hpp"
+#include "server/api_error.hpp"
 #include "server/dispatch_service.hpp"
 
 namespace corridor::server {
@@ -43,5 +45,13 @@ struct DispatchService::Mission {
   std::vector<ArcBatch> pending_arcs;  // the hierarchy's moved arcs, one batch per customization
   std::optional<std::string> pending_reason;
 };
+
+// A point that cannot be put on the map, as the API's 422 with its reason's code.
+inline ApiError snap_error(const maps::SnapError& e, const char* what) {
+  const char* code = e.reason() == maps::SnapError::Reason::invalid_coordinate ? "invalid_coordinate"
+                     : e.reason() == maps::SnapError::Reason::outside_map  ? "outside_map"
+                                                                            : "off_road";
+  return unprocessable(code, std::string(what) + ": " + e.what());
+}
 
 }  // namespace corridor::server

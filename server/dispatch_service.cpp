@@ -36,31 +36,9 @@ std::optional<MissionState> mission_state_from(const std::string& s) {
 
 namespace {
 
-ApiError snap_error(const maps::SnapError& e, const char* what) {
-  const char* code = e.reason() == maps::SnapError::Reason::invalid_coordinate ? "invalid_coordinate"
-                     : e.reason() == maps::SnapError::Reason::outside_map  ? "outside_map"
-                                                                            : "off_road";
-  return unprocessable(code, std::string(what) + ": " + e.what());
-}
-
 using localizer::angle_between_deg;
 // Compass bearing of edge e around offset, degrees clockwise from north.
 double bearing_deg(const maps::RoadGraph& g, EdgeId e, double offset_m) { return localizer::road_bearing_deg(g, e, offset_m, 1.0); }
-
-DispatchEvent position_event(const PositionReport& p, double now_s, MissionId mission, std::optional<double> eta_s) {
-  DispatchEvent e;
-  e.kind = "position";
-  e.mission = mission;
-  e.reason = p.source;
-  e.time_s = now_s;
-  e.vehicle_id = p.vehicle_id;
-  e.position = p.position;
-  e.heading_deg = p.heading_deg;
-  e.speed_mps = p.speed_mps;
-  e.source = p.source;
-  e.eta_s = eta_s;
-  return e;
-}
 
 }  // namespace
 
@@ -176,43 +154,6 @@ void DispatchService::emit(DispatchEvent event) {
   for (const auto& [id, l] : listeners_) l(event);
 }
 
-std::vector<VehicleView> DispatchService::vehicles() const {
-  std::vector<VehicleView> out;
-  std::shared_lock lock(registry_mutex_);
-  out.reserve(vehicles_.size());
-  for (const auto& [id, v] : vehicles_) {
-    out.push_back(v);
-    if (auto it = active_by_vehicle_.find(id); it != active_by_vehicle_.end()) out.back().mission = it->second;
-  }
-  std::sort(out.begin(), out.end(), [](const VehicleView& a, const VehicleView& b) { return a.vehicle_id < b.vehicle_id; });
-  return out;
-}
-
-std::vector<RouteRevisionView> DispatchService::route_history(MissionId id) const {
-  MissionPtr m;
-  {
-    std::shared_lock lock(registry_mutex_);
-    auto it = missions_.find(id);
-    if (it == missions_.end()) throw not_found("no mission " + std::to_string(id));
-    m = it->second;
-  }
-  std::vector<Mission::Revision> history;
-  {
-    std::lock_guard lock(m->mutex);
-    history = m->history;
-  }
-  // Rendered outside the mission's lock: the routes are copies.
-  std::vector<RouteRevisionView> out;
-  out.reserve(history.size());
-  for (auto& r : history) {
-    if (r.view.geometry_json.empty() && r.route) {
-      r.view.geometry_json = planner::route_to_geojson(graph_, *r.route, "dstar")["geometry"].dump();
-    }
-    out.push_back(std::move(r.view));
-  }
-  return out;
-}
-
 std::vector<planner::EdgePoint> DispatchService::endpoints(const maps::SnapResult& s, Role role,
                                                            std::optional<double> heading) const {
   auto points = planner::points_from_snap(graph_, s, role == Role::goal ? planner::PointRole::goal : planner::PointRole::start);
@@ -233,35 +174,6 @@ planner::VehicleProfile DispatchService::vehicle_profile(const MissionRow& row) 
   planner::VehicleProfile p = row.profile == "fire_engine" ? planner::fire_engine_profile() : planner::ambulance_profile();
   p.vmax_mps = row.vmax_kmh / 3.6;
   return p;
-}
-
-MissionView DispatchService::view(const Mission& m) const {
-  MissionView v;
-  v.id = m.row.id;
-  v.vehicle_id = m.row.vehicle_id;
-  v.state = m.row.state;
-  v.priority = m.row.priority;
-  v.vmax_kmh = m.row.vmax_kmh;
-  v.profile = m.row.profile;
-  v.destination = m.row.destination;
-  v.last_position = m.last_position;
-  v.route = m.route;
-  v.route_revision = m.revision;
-  v.route_time_s = m.route_time_s;
-  if (m.row.state == MissionState::active) {
-    {
-      std::shared_lock costs(overlay_mutex_);
-      v.congestion_factors.reserve(m.route.edges.size());
-      for (EdgeId e : m.route.edges) v.congestion_factors.push_back(overlay_.edge(e).congestion_factor);
-    }
-    std::lock_guard lock(preemption_mutex_);
-    v.schedule = preemption_.schedule(m.row.id);
-  } else {
-    v.schedule = m.final_schedule;
-  }
-  v.created_s = m.row.created_s;
-  v.updated_s = m.row.updated_s;
-  return v;
 }
 
 MissionPlanner DispatchService::make_planner(const MissionRow& row, std::vector<planner::EdgePoint> starts,
@@ -423,32 +335,6 @@ MissionView DispatchService::create_mission(const MissionRequest& req, double no
   return created;
 }
 
-MissionView DispatchService::mission(MissionId id) const {
-  MissionPtr m;
-  {
-    std::shared_lock lock(registry_mutex_);
-    auto it = missions_.find(id);
-    if (it == missions_.end()) throw not_found("no mission " + std::to_string(id));
-    m = it->second;
-  }
-  std::lock_guard lock(m->mutex);
-  return view(*m);
-}
-
-std::vector<MissionView> DispatchService::missions(std::optional<MissionState> state) const {
-  std::vector<MissionPtr> all;
-  {
-    std::shared_lock lock(registry_mutex_);
-    for (const auto& [id, m] : missions_) all.push_back(m);
-  }
-  std::vector<MissionView> out;
-  for (const auto& m : all) {
-    std::lock_guard lock(m->mutex);
-    if (!state || m->row.state == *state) out.push_back(view(*m));
-  }
-  return out;
-}
-
 DispatchService::MissionPtr DispatchService::find(MissionId id) const {
   std::shared_lock lock(registry_mutex_);
   auto it = missions_.find(id);
@@ -510,137 +396,6 @@ MissionView DispatchService::cancel_mission(MissionId id, double now_s) {
   lock.unlock();
   durable->wait();
   return cancelled;
-}
-
-PositionResult DispatchService::report_position(const PositionReport& p, double now_s) {
-  if (const auto problem = maps::id_problem(p.vehicle_id)) throw bad_request("vehicle id: the id " + *problem);
-  if (p.source != "gps" && p.source != "vo") throw bad_request("source must be \"gps\" or \"vo\"");
-  if (p.heading_deg && !(std::isfinite(*p.heading_deg) && *p.heading_deg >= 0.0 && *p.heading_deg <= 360.0)) {
-    throw bad_request("heading_deg must be within [0, 360]");
-  }
-  if (p.speed_mps && !(std::isfinite(*p.speed_mps) && *p.speed_mps >= 0.0 && *p.speed_mps < 150.0)) {
-    throw bad_request("speed_mps must be within [0, 150)");
-  }
-  if (p.hdop && !(std::isfinite(*p.hdop) && *p.hdop >= 0.0)) throw bad_request("hdop must be a number >= 0");
-  if (!(std::isfinite(p.timestamp_s) && p.timestamp_s >= 0.0)) {
-    throw bad_request("timestamp must be a finite number of seconds since the Unix epoch, >= 0");
-  }
-  // A report from the future would make every later one stale (the tracker keeps the newest time).
-  if (p.timestamp_s > now_s + config_.max_clock_ahead_s) {
-    throw bad_request(fmt::format("timestamp is {:g} s ahead of the server's clock; at most {:g} s of skew is taken",
-                                  p.timestamp_s - now_s, config_.max_clock_ahead_s));
-  }
-  // Off the map is bad input whatever else the report is: checked before the tracker.
-  maps::SnapResult snap;
-  try {
-    snap = snapper_.snap(p.position, {config_.snap_max_distance_m});
-  } catch (const maps::SnapError& e) {
-    throw snap_error(e, "position");
-  }
-  PositionResult result;
-  // The tracker first, alone: a stale, duplicate or outlying report, or GPS too poor to follow, is
-  // stored as received and moves nothing.
-  const TrackResult tracked = tracker_.track(p);
-  result.match.disposition = to_string(tracked.disposition);
-  if (tracked.disposition != Disposition::followed) {
-    Staged staged;
-    stage(staged, [p, now_s, match = result.match](Store& store) { store.insert_position(p, std::nullopt, now_s, match); });
-    result.durable = submit(staged);
-    return result;
-  }
-  if (tracked.match.matched) {
-    // The matcher's point: the road and direction the vehicle's recent fixes say it drives.
-    snap.edge = tracked.match.edge;
-    snap.offset_m = tracked.match.offset_m;
-    snap.point = tracked.match.point;
-    snap.distance_m = tracked.match.distance_m;
-    result.match.edge = tracked.match.edge;
-    result.match.offset_m = tracked.match.offset_m;
-    result.match.confidence = tracked.match.confidence;
-  }
-  result.snap_distance_m = snap.distance_m;
-  MissionPtr mp;
-  {
-    std::lock_guard lock(registry_mutex_);
-    VehicleView& v = vehicles_[p.vehicle_id];
-    v = {p.vehicle_id, p.position, p.heading_deg, p.speed_mps, p.timestamp_s, p.source, std::nullopt};
-    if (auto it = active_by_vehicle_.find(p.vehicle_id); it != active_by_vehicle_.end()) mp = missions_.at(it->second);
-  }
-  Staged staged;
-  std::unique_lock<std::mutex> lock;
-  if (mp) {
-    lock = std::unique_lock(mp->mutex);
-    if (mp->row.state != MissionState::active) mp.reset();  // it ended in between
-  }
-  if (!mp) {
-    stage(staged, [p, now_s, match = result.match](Store& store) { store.insert_position(p, std::nullopt, now_s, match); });
-    result.durable = submit(staged);
-    emit(position_event(p, now_s, 0, std::nullopt));  // a free vehicle moves on the console too
-    return result;
-  }
-  Mission& m = *mp;
-  result.mission = m.row.id;
-  stage(staged, [p, id = m.row.id, now_s, match = result.match](Store& store) { store.insert_position(p, id, now_s, match); });
-  m.last_position = p.position;
-
-  // Signals behind the vehicle: every intersection of the old route before its current edge. A
-  // matched point already knows its direction; a raw snap asks the heading.
-  auto points = tracked.match.matched ? std::vector<planner::EdgePoint>{{snap.edge, snap.offset_m}}
-                                      : endpoints(snap, Role::start, p.heading_deg);
-  // Still on the edge the route started from, or just onto the next one, the vehicle is in the
-  // turn-graph state the route drove it in: a via-way restriction it has entered still binds it
-  // after the replan. Further along (reports missed, a loop that uses an edge twice, a vehicle that
-  // left the route and came back another way) the way it came is not known, and it starts afresh.
-  for (planner::EdgePoint& q : points) {
-    for (std::size_t i = 0; i < 2 && i < m.route.edges.size(); ++i) {
-      if (m.route.edges[i] == q.edge) {
-        q.turn_vertex = m.route.point_on(i, 0.0).turn_vertex;
-        break;
-      }
-    }
-  }
-  const auto pos_in_route = std::find_if(m.route.edges.begin(), m.route.edges.end(), [&](EdgeId e) {
-    return std::any_of(points.begin(), points.end(), [&](const planner::EdgePoint& q) { return q.edge == e; });
-  });
-  if (pos_in_route != m.route.edges.end()) {
-    const auto passed = static_cast<std::size_t>(pos_in_route - m.route.edges.begin());
-    std::lock_guard signals(preemption_mutex_);
-    for (std::size_t i = 0; i < passed && i < m.route.nodes.size(); ++i) {
-      if (plans_.count(m.route.nodes[i]) != 0) preemption_.vehicle_passed(m.row.id, signals_map_.key(m.route.nodes[i]), now_s);
-    }
-  }
-
-  const std::vector<EdgeId> old_edges = m.route.edges;
-  // This repair also covers any cost change the planner heard of since its last one.
-  const std::string reason = repair(m, &points).value_or("off_route");
-  if (!m.route.found) {
-    // On a road cut off from the rest (a car park that joins no public road): on from the main
-    // component's nearest road, as when the mission was planned, rather than ending the mission.
-    if (const auto main = planner::main_component_snap(snapper_, graph_, p.position, snap, {config_.snap_max_distance_m})) {
-      auto from_main = endpoints(*main, Role::start, p.heading_deg);
-      repair(m, &from_main);
-    }
-  }
-  result.eta_s = m.route.travel_time_s;
-  m.route_time_s = now_s;
-  emit(position_event(p, now_s, m.row.id, m.route.found ? std::optional<double>(m.route.travel_time_s) : std::nullopt));
-  if (!m.route.found || m.route.length_m <= config_.arrival_radius_m ||
-      maps::distance_m(snap.point, m.destination_local) <= config_.arrival_radius_m) {
-    result.completed = true;
-    stage_state(m, MissionState::completed, now_s, staged);
-    finish(m, MissionState::completed, now_s, staged);
-  } else {
-    // The route changed if it is not the rest of the old one from the vehicle's edge on.
-    const auto from = std::find(old_edges.begin(), old_edges.end(), m.route.edges.front());
-    result.route_changed = !std::equal(from, old_edges.end(), m.route.edges.begin(), m.route.edges.end());
-    if (result.route_changed) {
-      publish_route(m, reason, now_s, staged);
-    } else {
-      retime_signals(m, now_s, staged);
-    }
-  }
-  result.durable = submit(staged);
-  return result;
 }
 
 std::size_t DispatchService::active_mission_count() const {
