@@ -1,4 +1,5 @@
 #include "ntcip/snmp_agent.hpp"
+#include "ntcip/snmp_logging.hpp"
 
 #include <net-snmp/net-snmp-config.h>
 #include <net-snmp/net-snmp-includes.h>
@@ -242,16 +243,6 @@ int on_message(int op, netsnmp_session* session, int /*reqid*/, netsnmp_pdu* pdu
   return 1;
 }
 
-int log_to_spdlog(int, int, void* serverarg, void*) {
-  const auto* m = static_cast<snmp_log_message*>(serverarg);
-  if (m->priority <= LOG_WARNING) {
-    std::string text = m->msg != nullptr ? m->msg : "";
-    while (!text.empty() && text.back() == '\n') text.pop_back();
-    spdlog::warn("event=snmp_library message=\"{}\"", text);
-  }
-  return 0;
-}
-
 }  // namespace
 
 SnmpAgent::SnmpAgent(AgentSecurity security) : security_(std::move(security)) {
@@ -263,8 +254,7 @@ SnmpAgent::SnmpAgent(AgentSecurity security) : security_(std::move(security)) {
   if (security_.state_dir.empty()) security_.state_dir = std::filesystem::temp_directory_path() / "corridor-signal-agent";
   std::filesystem::create_directories(security_.state_dir, ec);
   if (ec) throw SnmpError("cannot create the SNMP state directory " + security_.state_dir.string() + ": " + ec.message());
-  snmp_register_callback(SNMP_CALLBACK_LIBRARY, SNMP_CALLBACK_LOGGING, log_to_spdlog, nullptr);
-  snmp_enable_calllog();
+  route_snmp_logs_to_spdlog();
   // Only our own state is read: no snmp.conf from /etc or the home directory.
   netsnmp_ds_set_string(NETSNMP_DS_LIBRARY_ID, NETSNMP_DS_LIB_CONFIGURATION_DIR, security_.state_dir.c_str());
   netsnmp_ds_set_string(NETSNMP_DS_LIBRARY_ID, NETSNMP_DS_LIB_PERSISTENT_DIR, security_.state_dir.c_str());

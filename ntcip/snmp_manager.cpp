@@ -1,4 +1,5 @@
 #include "ntcip/snmp_manager.hpp"
+#include "ntcip/snmp_logging.hpp"
 
 #include <net-snmp/net-snmp-config.h>
 #include <net-snmp/net-snmp-includes.h>
@@ -139,22 +140,11 @@ void* open_session(const SnmpTarget& t, std::string& error) {
   return handle;
 }
 
-int log_to_spdlog(int, int, void* serverarg, void*) {
-  const auto* m = static_cast<snmp_log_message*>(serverarg);
-  if (m->priority <= LOG_WARNING) {
-    std::string text = m->msg != nullptr ? m->msg : "";
-    while (!text.empty() && text.back() == '\n') text.pop_back();
-    spdlog::warn("event=snmp_library message=\"{}\"", text);
-  }
-  return 0;
-}
-
 }  // namespace
 
 SnmpManager::SnmpManager() {
   if (pipe2(wake_, O_CLOEXEC | O_NONBLOCK) != 0) throw std::runtime_error("cannot create the SNMP manager's wake-up pipe");
-  snmp_register_callback(SNMP_CALLBACK_LIBRARY, SNMP_CALLBACK_LOGGING, log_to_spdlog, nullptr);
-  snmp_enable_calllog();
+  route_snmp_logs_to_spdlog();
   // Nothing read from /etc/snmp or the home directory, nothing written to /var/lib/snmp.
   netsnmp_ds_set_boolean(NETSNMP_DS_LIBRARY_ID, NETSNMP_DS_LIB_DONT_READ_CONFIGS, 1);
   netsnmp_ds_set_boolean(NETSNMP_DS_LIBRARY_ID, NETSNMP_DS_LIB_DONT_PERSIST_STATE, 1);

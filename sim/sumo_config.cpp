@@ -45,22 +45,6 @@ std::string canonical(const std::string& name) {
   return name;
 }
 
-std::vector<std::string> split_list(const std::string& text) {
-  std::vector<std::string> items;
-  std::string item;
-  for (std::size_t i = 0; i <= text.size(); ++i) {
-    if (i == text.size() || text[i] == ',' || text[i] == ';') {
-      const auto first = item.find_first_not_of(" \t\r\n");
-      const auto last = item.find_last_not_of(" \t\r\n");
-      if (first != std::string::npos) items.push_back(item.substr(first, last - first + 1));
-      item.clear();
-    } else {
-      item += text[i];
-    }
-  }
-  return items;
-}
-
 bool is_output_option(const std::string& name, const std::string& section) {
   return section == "output" || name.ends_with("-output") || name.ends_with("-dump") || name == "log" ||
          name == "message-log" || name == "error-log";
@@ -193,10 +177,10 @@ SumoConfig read_sumo_config(const std::filesystem::path& file) {
       c.net_file = resolve(name, value);
     } else if (name == "route-files") {
       c.route_files.clear();
-      for (const auto& item : split_list(value)) c.route_files.push_back(resolve(name, item));
+      for (const auto& item : split_files(value)) c.route_files.push_back(resolve(name, item));
     } else if (name == "additional-files") {
       c.additional_files.clear();
-      for (const auto& item : split_list(value)) c.additional_files.push_back(resolve(name, item));
+      for (const auto& item : split_files(value)) c.additional_files.push_back(resolve(name, item));
     } else if (name == "begin") {
       c.begin_s = time(name, value);
     } else if (name == "end") {

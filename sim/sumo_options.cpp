@@ -52,7 +52,8 @@ std::string xml_escape(const std::string& s) {
   return out;
 }
 
-// SUMO separates file lists with commas (and accepts semicolons).
+}  // namespace
+
 std::vector<std::string> split_files(const std::string& text) {
   std::vector<std::string> items;
   std::string item;
@@ -68,8 +69,6 @@ std::vector<std::string> split_files(const std::string& text) {
   }
   return items;
 }
-
-}  // namespace
 
 SumoOptionCatalog SumoOptionCatalog::from_template(const std::string& xml) {
   TemplateParse st;

@@ -52,6 +52,10 @@ struct SumoOptionValue {
 // same meaning; `redirect_output` names where a user's output file goes instead of beside their
 // files. Throws SimError for an option SUMO does not know (SUMO would refuse the file) and when the
 // file cannot be written.
+// A SUMO file list as SUMO reads it: separated by commas (or semicolons), each item trimmed, empty
+// items dropped.
+[[nodiscard]] std::vector<std::string> split_files(const std::string& text);
+
 void write_run_config(const std::filesystem::path& file, const SumoOptionCatalog& catalog,
                       const std::vector<SumoOptionValue>& user, const std::filesystem::path& user_dir,
                       const std::vector<std::pair<std::string, std::string>>& owned,
