@@ -48,10 +48,9 @@ struct HmmConfig {
   // Gaussians. Along a road the course follows its bearing to within the receiver's course error,
   // a lane change and the road's drawing (heading_sigma_deg); through a junction's turn, or where
   // a road is drawn coarsely, it sweeps far from it (heading_wide_sigma_deg, a share
-  // heading_wide_share of the fixes). One Gaussian wide enough for the turns (40°, the model
-  // until session 9) tells a road from a neighbour 30° off by only 0.3 (log-likelihood); one
-  // narrow enough for that would price every turn as an error. docs/experiments/localization.md
-  // gives what the mixture moved, on drives it was not chosen on as well.
+  // heading_wide_share of the fixes). One Gaussian wide enough for the turns (40°) tells a road
+  // from a neighbour 30° off by only 0.3 (log-likelihood), and one narrow enough for that would
+  // price every turn as an error (see docs/experiments/localization.md, The course as a mixture).
   double heading_sigma_deg = 10.0;
   double heading_wide_sigma_deg = 40.0;
   double heading_wide_share = 0.2;
