@@ -56,6 +56,10 @@ struct SignalPlan {
   // plans, where a movement is one link). Where set it identifies movements exactly; otherwise
   // they are matched by compass sides.
   std::vector<EdgeId> movement_edge;
+  // Optional, per movement: the other movements whose vehicles queue in the same lane (SUMO plans,
+  // from the links' lanes). A vehicle making one waits behind the first vehicle making another, so
+  // a hold for one shows them all green, or the vehicle stands behind a red it does not take.
+  std::vector<std::vector<std::size_t>> lane_mates;
 
   [[nodiscard]] bool conflicts(std::size_t a, std::size_t b) const { return conflict[a * movements.size() + b] != 0; }
   [[nodiscard]] std::optional<std::size_t> movement_index(Compass from, Compass to) const;

@@ -144,11 +144,21 @@ std::unordered_map<NodeId, SignalPlan> plans_by_node(const SumoGraph& graph, con
       }
       if (std::find(approaches.begin(), approaches.end(), from->second) == approaches.end()) approaches.push_back(from->second);
     }
+    // Links that leave from one lane share its queue.
+    std::vector<std::vector<std::size_t>> lane_mates(sp.links.size());
+    for (std::size_t k = 0; k < sp.links.size(); ++k) {
+      for (std::size_t j = 0; j < sp.links.size(); ++j) {
+        const SumoConnection* a = sp.links[k];
+        const SumoConnection* b = sp.links[j];
+        if (j != k && a != nullptr && b != nullptr && a->from == b->from && a->from_lane == b->from_lane) lane_mates[k].push_back(j);
+      }
+    }
     for (NodeId node : approaches) {
       if (out.contains(node)) continue;
       SignalPlan plan = sp.plan;
       plan.node = node;
       plan.movement_edge = movement_edge;
+      plan.lane_mates = lane_mates;
       out.emplace(node, std::move(plan));
       if (tls_of != nullptr) (*tls_of)[node] = i;
     }

@@ -124,7 +124,21 @@ bool PreemptionEngine::time_entry(ScheduleEntry& e, std::span<const Crossing> gr
     const std::optional<std::size_t> m = plan_movement(graph_, plan, g.in_edge, g.out_edge);
     if (m && std::find(e.movements.begin(), e.movements.end(), *m) == e.movements.end()) e.movements.push_back(*m);
   }
-  const std::span<const std::size_t> also(e.movements.data() + 1, e.movements.size() - 1);
+  // The phase also serves every movement that shares a lane with one of the vehicle's, so that no
+  // vehicle ahead of it waits at a red the hold keeps (a through car in a shared left lane).
+  std::vector<std::size_t> with(e.movements.begin() + 1, e.movements.end());
+  if (!plan.lane_mates.empty()) {
+    for (std::size_t m : e.movements) {
+      if (m >= plan.lane_mates.size()) continue;
+      for (std::size_t mate : plan.lane_mates[m]) {
+        if (std::find(e.movements.begin(), e.movements.end(), mate) == e.movements.end() &&
+            std::find(with.begin(), with.end(), mate) == with.end()) {
+          with.push_back(mate);
+        }
+      }
+    }
+  }
+  const std::span<const std::size_t> also(with);
 
   const QueueEstimator* queue = nullptr;
   if (auto it = queues_.find(c.node); it != queues_.end() && it->second.has_data(from)) queue = &it->second;

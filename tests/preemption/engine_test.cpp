@@ -107,6 +107,55 @@ TEST(PreemptionEngine, SchedulesTheChosenPhaseAtTheComputedStart) {
   EXPECT_TRUE(rig.monitor.violations().empty()) << rig.monitor.violations().front();
 }
 
+// A left turn whose lane it shares with the through movement (one lane on the approach, as SUMO's
+// links say): a hold that shows the left alone leaves a through car ahead of the vehicle at red, and
+// the vehicle behind it. With the lane known, the hold shows both.
+TEST(PreemptionEngine, AMovementThatSharesTheVehiclesLaneIsGreenWithIt) {
+  // Movements: 0 N->E (left), 1 N->S, 2 S->N, 3 E->W. The left has a protected phase of its own.
+  const maps::RoadGraph g = plus_junction();
+  const NodeId c = g.head(edge(g, kN, kC));
+  maps::SignalPlan plan;
+  plan.node = c;
+  plan.movements = {{maps::Compass::north, maps::Compass::east, maps::Turn::left, 0},
+                    {maps::Compass::north, maps::Compass::south, maps::Turn::through, 0},
+                    {maps::Compass::south, maps::Compass::north, maps::Turn::through, 0},
+                    {maps::Compass::east, maps::Compass::west, maps::Turn::through, 0}};
+  plan.conflict.assign(16, 0);
+  for (const auto& [x, y] : std::vector<std::pair<int, int>>{{0, 2}, {0, 3}, {1, 3}, {2, 3}}) plan.conflict[x * 4 + y] = plan.conflict[y * 4 + x] = 1;
+  plan.phases = {{"N-left", {1, 0, 0, 0}, 5.0}, {"NS", {0, 1, 1, 0}, 5.0}, {"EW", {0, 0, 0, 1}, 5.0}};
+  plan.program = {{1, 30.0}, {0, 10.0}, {2, 30.0}};
+  const auto held_phase = [&](bool lanes_known) {
+    maps::SignalPlan p = plan;
+    if (lanes_known) p.lane_mates = {{1}, {0}, {}, {}};
+    std::unordered_map<NodeId, maps::SignalPlan> plans{{c, p}};
+    SimulatedSignalController controller(plans, 0.0);
+    SafetyMonitor monitor;
+    monitor.watch(plans.at(c), controller.lights(c), 0.0);
+    controller.set_observer([&](NodeId n, const std::vector<Light>& l, double t) { monitor.observe(n, l, t); });
+    PreemptionEngine engine(g, plans, controller);
+    engine.update_route(1, 1, std::vector<Crossing>{{c, edge(g, kN, kC), edge(g, kC, kE), 60.0}}, 0.0);
+    const maps::Phase phase = engine.schedule(1).at(0).phase;
+    for (double t = 0.0; t <= 60.0; t += 0.5) {
+      controller.advance(t);
+      engine.tick(t);
+    }
+    EXPECT_EQ(controller.lights(c)[0], Light::green);
+    EXPECT_EQ(controller.lights(c)[1] == Light::green, lanes_known);
+    engine.vehicle_passed(1, c, 61.0);
+    for (double t = 61.0; t <= 150.0; t += 0.5) {
+      controller.advance(t);
+      engine.tick(t);
+    }
+    EXPECT_EQ(controller.mode(c), SignalMode::program);
+    EXPECT_TRUE(monitor.violations().empty()) << monitor.violations().front();
+    return std::pair{phase.serves(0), phase.serves(1)};
+  };
+  // Without lane data the protected left alone is held: a through car ahead would wait at red.
+  EXPECT_EQ(held_phase(false), std::pair(true, false));
+  // With the lane known, the hold shows the through movement too.
+  EXPECT_EQ(held_phase(true), std::pair(true, true));
+}
+
 TEST(PreemptionEngine, ExtendsAPhaseThatAlreadyServesTheVehicle) {
   Rig rig;
   const std::vector<Crossing> route{rig.crossing(kN, kS, 30.0)};

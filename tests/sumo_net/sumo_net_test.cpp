@@ -181,6 +181,29 @@ TEST(SumoGraph, SignalPlansSitOnTheStopLinesTheirLightControlsWithExactMovements
   }
 }
 
+TEST(SumoGraph, LinksFromOneLaneAreEachOthersLaneMates) {
+  const SumoNet& net = monaco();
+  const SumoGraph g = build_sumo_graph(net);
+  const auto sumo_plans = sumo_signal_plans(net);
+  std::unordered_map<NodeId, std::size_t> tls_of;
+  const auto plans = plans_by_node(g, net, sumo_plans, &tls_of);
+  std::size_t shared = 0;
+  for (const auto& [node, plan] : plans) {
+    const SumoSignalPlan& sp = sumo_plans.at(tls_of.at(node));
+    ASSERT_EQ(plan.lane_mates.size(), sp.links.size());
+    for (std::size_t k = 0; k < sp.links.size(); ++k) {
+      for (std::size_t j = 0; j < sp.links.size(); ++j) {
+        const bool same_lane = j != k && sp.links[k] != nullptr && sp.links[j] != nullptr && sp.links[k]->from == sp.links[j]->from &&
+                               sp.links[k]->from_lane == sp.links[j]->from_lane;
+        const auto& mates = plan.lane_mates[k];
+        EXPECT_EQ(std::find(mates.begin(), mates.end(), j) != mates.end(), same_lane) << "links " << k << " and " << j;
+        shared += same_lane ? 1 : 0;
+      }
+    }
+  }
+  EXPECT_GT(shared, 0u);  // Monaco has approaches whose one lane serves two movements
+}
+
 }  // namespace
 }  // namespace corridor::maps
 
