@@ -11,31 +11,12 @@
 #include "maps/intersection_geometry.hpp"
 #include "preemption/safety_monitor.hpp"
 #include "preemption/simulated_signal_controller.hpp"
+#include "tests/preemption/engine_rig.hpp"
 
 namespace corridor::ntcip {
 namespace {
 
-// A four-legged signalized junction with legs 200 m to the N, E, S and W.
-maps::RoadGraph plus_junction() {
-  maps::GraphBuildInput in;
-  in.origin = {47.0, 9.5};
-  in.node_pos = {{0, 0}, {0, 200}, {200, 0}, {0, -200}, {-200, 0}};
-  for (std::int64_t i = 0; i < 5; ++i) in.node_osm.push_back(OsmNodeId{i + 1});
-  in.node_signalized = {1, 0, 0, 0, 0};
-  for (std::uint32_t leg = 1; leg <= 4; ++leg) {
-    maps::RoadSegment s;
-    s.from = 0;
-    s.to = leg;
-    s.first_point = static_cast<std::uint32_t>(in.points.size());
-    in.points.push_back(in.node_pos[0]);
-    in.points.push_back(in.node_pos[leg]);
-    s.last_point = s.first_point + 1;
-    s.forward_speed_mps = s.backward_speed_mps = 14.0f;
-    s.way = OsmWayId{leg};
-    in.segments.push_back(s);
-  }
-  return maps::build_road_graph(in);
-}
+using preemption::plus_junction;  // legs 200 m to the N, E, S and W
 
 struct Rig {
   maps::RoadGraph graph = plus_junction();
